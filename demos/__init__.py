@@ -1,0 +1,1 @@
+"""Demos: data players, the simulated world and missions, and real-data replays."""

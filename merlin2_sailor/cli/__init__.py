@@ -1,0 +1,1 @@
+"""The ``sailor`` command-line tool: one module per subcommand, each with add_parser() and run()."""

@@ -1,0 +1,1 @@
+"""Measurements of a running graph (topic rates, message ages) without ROS command-line tools."""

@@ -1,0 +1,53 @@
+"""Run a node until Ctrl-C, SIGTERM or an external shutdown, and always clean up.
+
+Every entry point goes through :func:`run_node`, so all nodes shut down the same way: the
+executor is shut down, the node destroyed and the context shut down, and the process exits 0
+after a requested stop. A node that leaves an executor thread spinning at exit aborts the
+interpreter, so nothing is left to chance here.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+from collections.abc import Callable, Sequence
+
+import rclpy
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor, SingleThreadedExecutor
+from rclpy.node import Node
+
+from merlin2_sailor.errors import SailorError
+
+
+def run_node(
+    make_node: Callable[[], Node],
+    argv: Sequence[str] | None = None,
+    threads: int = 1,
+) -> int:
+    """Create the node with ``make_node`` and spin it; return the process exit code.
+
+    ``threads`` > 1 uses a multi-threaded executor, for nodes whose service callbacks must not
+    wait behind long subscription callbacks. A SailorError while building the node (a bad
+    parameter, a missing model file) is logged as one line and exits with code 2.
+    """
+    rclpy.init(args=list(argv) if argv is not None else sys.argv)
+    # SIGTERM (the launcher's second step, systemd, docker stop) shuts down like Ctrl-C.
+    signal.signal(signal.SIGTERM, lambda *_: rclpy.try_shutdown())
+    node: Node | None = None
+    executor = MultiThreadedExecutor(num_threads=threads) if threads > 1 else SingleThreadedExecutor()
+    try:
+        node = make_node()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except SailorError as error:
+        name = node.get_name() if node is not None else "node"
+        print(f"[{name}] cannot start: {error}", file=sys.stderr, flush=True)
+        return 2
+    finally:
+        executor.shutdown()
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

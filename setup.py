@@ -1,0 +1,50 @@
+"""Install merlin2_sailor as an ament_python package.
+
+The ROS-free core lives in ``merlin2_sailor``; the state-machine behaviors and the demos live in
+the top-level folders ``behaviors/`` and ``demos/`` of the repository and install as
+``merlin2_sailor_behaviors`` and ``merlin2_sailor_demos``, so nothing claims the generic names
+``behaviors`` or ``demos`` in a user's Python environment.
+"""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE_NAME = "merlin2_sailor"
+
+# Each ROS node, as "executable = module:function". The executable names are the ones that
+# launch files and the README use.
+NODE_ENTRY_POINTS = [
+    "rgbd_player = merlin2_sailor_demos.rgbd_player_node:main",
+    "topic_monitor = merlin2_sailor.ros.topic_monitor_node:main",
+]
+
+# Command-line tools.
+TOOL_ENTRY_POINTS = [
+    "sailor = merlin2_sailor.cli.main:main",
+]
+
+setup(
+    name=PACKAGE_NAME,
+    version="0.1.0",
+    packages=find_packages(include=[PACKAGE_NAME, f"{PACKAGE_NAME}.*"])
+    + ["merlin2_sailor_behaviors", "merlin2_sailor_demos"],
+    package_dir={
+        "merlin2_sailor_behaviors": "behaviors",
+        "merlin2_sailor_demos": "demos",
+    },
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE_NAME}"]),
+        (f"share/{PACKAGE_NAME}", ["package.xml"]),
+        (f"share/{PACKAGE_NAME}/config", glob("config/*")),
+        (f"share/{PACKAGE_NAME}/launch", glob("launch/*")),
+    ],
+    install_requires=["setuptools"],
+    zip_safe=True,
+    maintainer="merlin2_sailor developers",
+    maintainer_email="dev@merlin2-sailor.local",
+    description="SAILOR symbolic anchoring for ROS 2 Jazzy, as a MERLIN2 skill.",
+    license="Apache-2.0",
+    python_requires=">=3.10",
+    entry_points={"console_scripts": NODE_ENTRY_POINTS + TOOL_ENTRY_POINTS},
+)

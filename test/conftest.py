@@ -1,0 +1,156 @@
+"""Test-wide set-up: isolate ROS traffic to this run, and offer a probe into the ROS graph.
+
+The environment is set before any test imports rclpy: DDS discovery stays on loopback, each run
+gets its own ROS_DOMAIN_ID (so parallel runs on one machine never see each other's nodes), logs
+go to a temporary folder, and Fast DDS uses the project's profile, as ``sailor launch`` does.
+Child processes started by the tests inherit all of it.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
+
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+os.environ.setdefault("ROS_LOG_DIR", tempfile.mkdtemp(prefix="sailor-test-ros-logs-"))
+os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "config" / "fastdds.xml"))
+os.environ.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
+
+# --- Fixtures for tests that talk to real nodes over DDS -----------------------------------
+# ros_probe gives a node spinning in a background thread of its own context and guarantees the
+# teardown (executor shut down, thread joined, node destroyed, context shut down): an executor
+# left spinning at exit aborts the interpreter. node_process starts console scripts as real
+# processes and stops them with SIGINT.
+
+
+GRAPH_TIMEOUT_SECONDS = 20.0
+
+
+class RosProbe:
+    """A node of the test's own, to look into the graph and exchange messages with nodes."""
+
+    def __init__(self) -> None:
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+
+        self._rclpy = rclpy
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context)
+        self.node = rclpy.create_node(f"test_probe_{os.getpid()}", context=self.context)
+        self._executor = SingleThreadedExecutor(context=self.context)
+        self._executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self) -> None:
+        from rclpy.executors import ExternalShutdownException
+
+        try:
+            self._executor.spin()
+        except ExternalShutdownException:
+            pass
+
+    def node_names(self) -> set[str]:
+        """Fully qualified names of the nodes currently in the graph."""
+        return {
+            f"{namespace.rstrip('/')}/{name}"
+            for name, namespace in self.node.get_node_names_and_namespaces()
+        }
+
+    def wait_for(self, condition: Callable[[], bool], timeout: float = GRAPH_TIMEOUT_SECONDS) -> bool:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if condition():
+                return True
+            time.sleep(0.05)
+        return condition()
+
+    def wait_for_node(self, full_name: str, timeout: float = GRAPH_TIMEOUT_SECONDS) -> bool:
+        return self.wait_for(lambda: full_name in self.node_names(), timeout)
+
+    def collect(self, message_type: Any, topic: str, count: int, qos: Any,
+                timeout: float = GRAPH_TIMEOUT_SECONDS) -> list[Any]:
+        """Subscribe to ``topic`` and return the first ``count`` messages (fewer on timeout)."""
+        received: list[Any] = []
+        subscription = self.node.create_subscription(message_type, topic, received.append, qos)
+        try:
+            self.wait_for(lambda: len(received) >= count, timeout)
+        finally:
+            self.node.destroy_subscription(subscription)
+        return received[:count]
+
+    def close(self) -> None:
+        self._executor.shutdown()
+        self._rclpy.try_shutdown(context=self.context)
+        self._thread.join(timeout=5.0)
+        self.node.destroy_node()
+
+
+@pytest.fixture
+def ros_probe() -> Iterator[RosProbe]:
+    probe = RosProbe()
+    try:
+        yield probe
+    finally:
+        probe.close()
+
+
+def scripts_directory() -> Path:
+    return Path(sys.executable).parent
+
+
+@dataclass
+class NodeProcess:
+    """A node started as a real process; stop() sends SIGINT and returns the exit code."""
+
+    process: subprocess.Popen[str]
+    output: list[str] = field(default_factory=list)
+
+    def stop(self, timeout: float = 15.0) -> int:
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+        try:
+            out, _ = self.process.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            out, _ = self.process.communicate()
+        self.output.append(out or "")
+        return self.process.returncode
+
+    @property
+    def text(self) -> str:
+        return "".join(self.output)
+
+
+@pytest.fixture
+def node_process() -> Iterator[Callable[..., NodeProcess]]:
+    """Start console scripts of this venv (``node_process('rgbd_player', '--ros-args', ...)``)."""
+    started: list[NodeProcess] = []
+
+    def start(executable: str, *arguments: str) -> NodeProcess:
+        process = subprocess.Popen(
+            [str(scripts_directory() / executable), *arguments],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, text=True,
+            env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        )
+        handle = NodeProcess(process)
+        started.append(handle)
+        return handle
+
+    yield start
+    for handle in started:
+        handle.stop()

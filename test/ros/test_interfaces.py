@@ -1,0 +1,70 @@
+"""merlin2_sailor_interfaces: every type imports and survives serialisation unchanged."""
+
+from __future__ import annotations
+
+import pytest
+from rclpy.serialization import deserialize_message, serialize_message
+
+from merlin2_sailor_interfaces import msg, srv
+
+MESSAGE_TYPES = [
+    msg.Point2D, msg.Vector2, msg.Pose2D, msg.BoundingBox2D, msg.BoundingBox3D, msg.Mask,
+    msg.Detection, msg.DetectionArray, msg.Percept, msg.PerceptArray, msg.Anchor, msg.AnchorArray,
+]
+SERVICE_TYPES = [srv.GetAnchors, srv.FindAnchor, srv.ForgetAnchor]
+
+
+def sample_detection() -> msg.Detection:
+    detection = msg.Detection(class_id=47, class_name="cup", score=0.83, id="12")
+    detection.bbox.center.position.x, detection.bbox.center.position.y = 320.5, 240.25
+    detection.bbox.size.x, detection.bbox.size.y = 40.0, 60.0
+    detection.bbox3d.frame_id = "map"
+    detection.bbox3d.size.z = 0.12
+    detection.mask.height, detection.mask.width = 480, 640
+    detection.mask.data = [msg.Point2D(x=1.0, y=2.0), msg.Point2D(x=3.0, y=4.0)]
+    return detection
+
+
+def sample_anchor() -> msg.Anchor:
+    anchor = msg.Anchor(symbol="cup_3", class_name="cup", state=msg.Anchor.STATE_CONFIRMED,
+                        confidence=0.9, times_seen=17, last_tracker_id="12")
+    anchor.position.x, anchor.position.y, anchor.position.z = 1.5, -2.0, 0.8
+    anchor.first_seen.sec, anchor.last_seen.sec = 10, 25
+    return anchor
+
+
+@pytest.mark.parametrize("message_type", MESSAGE_TYPES, ids=lambda t: t.__name__)
+def test_every_message_round_trips_through_serialisation(message_type: type) -> None:
+    original = message_type()
+    assert deserialize_message(serialize_message(original), message_type) == original
+
+
+def test_filled_messages_round_trip_with_all_fields() -> None:
+    array = msg.DetectionArray(detections=[sample_detection(), msg.Detection(class_name="dog")])
+    array.header.frame_id = "camera_color_optical_frame"
+    array.header.stamp.sec, array.header.stamp.nanosec = 5, 500
+    assert deserialize_message(serialize_message(array), msg.DetectionArray) == array
+
+    anchors = msg.AnchorArray(anchors=[sample_anchor()])
+    assert deserialize_message(serialize_message(anchors), msg.AnchorArray) == anchors
+
+    percept = msg.Percept(class_name="cup", class_id=47, score=0.9, tracker_id="")
+    percept.crop.height, percept.crop.width, percept.crop.encoding = 2, 1, "rgb8"
+    percept.crop.step, percept.crop.data = 3, bytes(range(6))
+    restored = deserialize_message(serialize_message(msg.PerceptArray(percepts=[percept])), msg.PerceptArray)
+    assert restored.percepts[0] == percept
+
+
+def test_anchor_states_are_the_lifecycle_in_order() -> None:
+    states = [msg.Anchor.STATE_TENTATIVE, msg.Anchor.STATE_CONFIRMED,
+              msg.Anchor.STATE_MISSING, msg.Anchor.STATE_FORGOTTEN]
+    assert states == [0, 1, 2, 3]
+
+
+@pytest.mark.parametrize("service_type", SERVICE_TYPES, ids=lambda t: t.__name__)
+def test_every_service_request_and_response_round_trips(service_type: type) -> None:
+    for part in (service_type.Request, service_type.Response):
+        original = part()
+        assert deserialize_message(serialize_message(original), part) == original
+    response = srv.FindAnchor.Response(found=True, anchor=sample_anchor(), message="")
+    assert deserialize_message(serialize_message(response), srv.FindAnchor.Response) == response
