@@ -16,7 +16,7 @@ demo: setup
 		$(VENV)/bin/sailor launch camera --duration $(DEMO_DURATION)
 
 test: setup
-	@$(VENV)/bin/python -m pytest
+	@SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Idempotent set-up of merlin2_sailor in ./.venv, with nothing installed by hand:
 #   1. a Python 3.11 virtual environment (the ROS 2 Jazzy wheels are built for CPython 3.11 only);
-#   2. the pinned dependencies of requirements.txt and requirements-build.txt;
+#   2. the pinned dependencies of requirements.txt and requirements-build.txt, and those of
+#      requirements-nodeps.txt without their declared dependencies;
 #   3. merlin2_sailor_interfaces built with cmake + rosidl and installed into the venv;
 #   4. merlin2_sailor itself, in editable mode.
 # Each step records a hash of its inputs in .venv/.sailor-*.sha and is skipped when they have not
@@ -55,13 +56,15 @@ pip_quiet=()
 pip_install() { "$python" -m pip install --disable-pip-version-check "${pip_quiet[@]}" "$@"; }
 
 # 2. Pinned dependencies.
-deps_hash="$(inputs_hash requirements.txt requirements-build.txt constraints.txt)"
+deps_hash="$(inputs_hash requirements.txt requirements-build.txt requirements-nodeps.txt constraints.txt)"
 if ! up_to_date deps "$deps_hash"; then
   say "installing pinned dependencies (first run: about a minute)"
   constraint_args=()
   [ -f constraints.txt ] && constraint_args=(-c constraints.txt)
   pip_install -r requirements.txt -r requirements-build.txt "${constraint_args[@]}" \
     || die "pip could not install the pinned dependencies (see above)."
+  pip_install --no-deps -r requirements-nodeps.txt \
+    || die "pip could not install requirements-nodeps.txt (see above)."
   mark_done deps "$deps_hash"
 fi
 

@@ -2,16 +2,25 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 
 from merlin2_sailor_interfaces import msg, srv
 
-MESSAGE_TYPES = [
-    msg.Point2D, msg.Vector2, msg.Pose2D, msg.BoundingBox2D, msg.BoundingBox3D, msg.Mask,
-    msg.Detection, msg.DetectionArray, msg.Percept, msg.PerceptArray, msg.Anchor, msg.AnchorArray,
-]
-SERVICE_TYPES = [srv.GetAnchors, srv.FindAnchor, srv.ForgetAnchor]
+# Every type defined in the interfaces package's sources, so a new .msg or .srv is tested at once.
+INTERFACES_SOURCE = Path(__file__).resolve().parents[2] / "merlin2_sailor_interfaces"
+MESSAGE_TYPES = [getattr(msg, path.stem) for path in sorted(INTERFACES_SOURCE.glob("msg/*.msg"))]
+SERVICE_TYPES = [getattr(srv, path.stem) for path in sorted(INTERFACES_SOURCE.glob("srv/*.srv"))]
+
+
+def test_the_interfaces_cover_detections_percepts_anchors_and_the_knowledge_base() -> None:
+    names = {message_type.__name__ for message_type in MESSAGE_TYPES + SERVICE_TYPES}
+    assert {"Detection", "DetectionArray", "Percept", "PerceptArray", "Anchor", "AnchorArray",
+            "GetAnchors", "FindAnchor", "ForgetAnchor", "PddlProposition", "KnowledgeChanges",
+            "ApplyChanges", "NewSymbol", "GetPropositions", "UpdateProposition",
+            "DeleteAllPropositions"} <= names
 
 
 def sample_detection() -> msg.Detection:

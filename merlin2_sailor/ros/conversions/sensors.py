@@ -1,4 +1,4 @@
-"""Every conversion between ROS messages and the core's Python objects, in one module.
+"""Images, depth, camera intrinsics and stamps: sensor messages to NumPy and back.
 
 cv_bridge is not installable from PyPI (its PyPI namesake is an old ROS 1 copy that breaks on
 NumPy 2), so images are converted here with NumPy alone. Conversions validate what they read:
@@ -7,9 +7,6 @@ the message, never a crash deep inside an algorithm.
 """
 
 from __future__ import annotations
-
-import importlib
-from typing import Any
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -126,15 +123,3 @@ def camera_info_message(
     message.r = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
     message.p = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]
     return message
-
-
-def message_class(type_name: str) -> Any:
-    """Import a message class from its ROS type name, e.g. 'sensor_msgs/msg/Image'."""
-    parts = type_name.split("/")
-    if len(parts) != 3 or parts[1] not in ("msg", "srv", "action"):
-        raise InvalidInputError(f"'{type_name}' is not a ROS type name like 'package/msg/Type'")
-    package, kind, name = parts
-    try:
-        return getattr(importlib.import_module(f"{package}.{kind}"), name)
-    except (ImportError, AttributeError) as error:
-        raise InvalidInputError(f"message type '{type_name}' is not installed") from error

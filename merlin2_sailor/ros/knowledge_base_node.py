@@ -1,0 +1,193 @@
+"""knowledge_base: a knowledge-base store served over ROS 2, with KANT-shaped services.
+
+Any component reaches the store through these services (or through
+:class:`~merlin2_sailor.ros.knowledge_base_client.RemoteKnowledgeBase`, which implements the same
+``KnowledgeBase`` port over them), so the store has exactly one writer, as each local store
+requires. Every batch that changed something is published on ``knowledge_changes``.
+
+Services (relative names; the node runs under ``/merlin2`` by default, as MERLIN2's KB does):
+``get_<kinds>``, ``update_<kind>``, ``delete_all_<kinds>`` for types, objects, predicates,
+propositions and actions, plus ``apply_changes`` (a batch in one transaction) and
+``new_symbol`` (the persistent anchor-symbol counter). A refused request is answered with
+``success = false`` and the reason; it never stops the node.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import KnowledgeChanges
+from rclpy.node import Node
+from std_msgs.msg import Header
+
+from merlin2_sailor.errors import KnowledgeError, SailorError
+from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind
+from merlin2_sailor.knowledge.model import KnowledgeItem
+from merlin2_sailor.knowledge.naming import symbol, to_identifier
+from merlin2_sailor.knowledge.store import KnowledgeBase
+from merlin2_sailor.knowledge.stores import open_store
+from merlin2_sailor.ros.conversions import knowledge as convert
+from merlin2_sailor.ros.node_runner import run_node
+from merlin2_sailor.ros.parameters import declare_parameter
+from merlin2_sailor.ros.qos import EVENTS
+
+NODE_NAME = "knowledge_base"
+CHANGES_TOPIC = "knowledge_changes"
+
+
+@dataclass(frozen=True)
+class _KindServices:
+    """The service types and message codecs of one kind of item."""
+
+    kind: ItemKind
+    plural: str
+    get_type: Any
+    update_type: Any
+    delete_all_type: Any
+    to_message: Callable[[Any], Any]
+    from_message: Callable[[Any], KnowledgeItem]
+
+
+KIND_SERVICES = (
+    _KindServices(ItemKind.TYPE, "types", srv.GetTypes, srv.UpdateType, srv.DeleteAllTypes,
+                  convert.type_to_message, convert.type_from_message),
+    _KindServices(ItemKind.OBJECT, "objects", srv.GetObjects, srv.UpdateObject, srv.DeleteAllObjects,
+                  convert.object_to_message, convert.object_from_message),
+    _KindServices(ItemKind.PREDICATE, "predicates", srv.GetPredicates, srv.UpdatePredicate,
+                  srv.DeleteAllPredicates, convert.predicate_to_message, convert.predicate_from_message),
+    _KindServices(ItemKind.PROPOSITION, "propositions", srv.GetPropositions, srv.UpdateProposition,
+                  srv.DeleteAllPropositions, convert.proposition_to_message,
+                  convert.proposition_from_message),
+    _KindServices(ItemKind.ACTION, "actions", srv.GetActions, srv.UpdateAction, srv.DeleteAllActions,
+                  convert.action_to_message, convert.action_from_message),
+)
+
+
+class KnowledgeBaseNode(Node):
+    def __init__(self, store: KnowledgeBase | None = None, **node_options: Any) -> None:
+        super().__init__(NODE_NAME, **node_options)
+        location = declare_parameter(
+            self, "store", "memory",
+            "Where the knowledge lives: 'memory', 'sqlite:///path/kb.db' or 'mongodb://host:port/db'.",
+        )
+        self._store = store if store is not None else open_store(location)
+        self._batch = 0
+        self._writer = ""  # writer of the batch being applied, echoed on the change topic
+        self._changes_publisher = self.create_publisher(KnowledgeChanges, CHANGES_TOPIC, EVENTS)
+        self._unsubscribe = self._store.subscribe(self._publish_changes)
+        for services in KIND_SERVICES:
+            self._serve_kind(services)
+        self.create_service(srv.ApplyChanges, "apply_changes", self._apply_changes)
+        self.create_service(srv.NewSymbol, "new_symbol", self._new_symbol)
+        counts = ", ".join(f"{len(self._store.get_all(s.kind))} {s.plural}" for s in KIND_SERVICES)
+        self.get_logger().info(f"serving the '{location}' store ({counts})")
+
+    def destroy_node(self) -> None:
+        self._unsubscribe()
+        self._store.close()
+        super().destroy_node()
+
+    # Publishing.
+
+    def _publish_changes(self, events: Sequence[ChangeEvent]) -> None:
+        """Called by the store inside each batch that changed something, in batch order."""
+        self._batch += 1
+        self._changes_publisher.publish(KnowledgeChanges(
+            header=Header(stamp=self.get_clock().now().to_msg()),
+            batch=self._batch,
+            writer=self._writer,
+            changes=[convert.event_to_message(event) for event in events],
+        ))
+
+    # Services.
+
+    def _serve_kind(self, services: _KindServices) -> None:
+        singular = services.kind.value
+        self.create_service(services.get_type, f"get_{services.plural}",
+                            lambda request, response: self._get(services, request, response))
+        self.create_service(services.update_type, f"update_{singular}",
+                            lambda request, response: self._update(services, request, response))
+        self.create_service(services.delete_all_type, f"delete_all_{services.plural}",
+                            lambda request, response: self._delete_all(services, request, response))
+
+    def _get(self, services: _KindServices, request: Any, response: Any) -> Any:
+        items: Sequence[KnowledgeItem]
+        if services.kind is ItemKind.PROPOSITION:
+            items = (self._store.propositions_about(request.object_name) if request.object_name
+                     else self._store.get_all(services.kind))
+            if request.predicate:
+                items = [item for item in items if item.predicate == request.predicate]  # type: ignore[union-attr]
+        elif request.name:
+            found = self._store.get(services.kind, request.name)
+            items = [found] if found is not None else []
+        else:
+            items = self._store.get_all(services.kind)
+        setattr(response, services.plural, [services.to_message(item) for item in items])
+        return response
+
+    def _update(self, services: _KindServices, request: Any, response: Any) -> Any:
+        def change() -> list[Change]:
+            item = services.from_message(getattr(request, services.kind.value))
+            if request.operation == request.OPERATION_SAVE:
+                return [Change.save(item)]
+            if request.operation == request.OPERATION_DELETE:
+                return [Change.delete(item)]
+            raise KnowledgeError(f"unknown operation {request.operation}; use OPERATION_SAVE or OPERATION_DELETE")
+
+        return self._write(change, response)
+
+    def _delete_all(self, services: _KindServices, _request: Any, response: Any) -> Any:
+        return self._write(lambda: [Change.delete(item) for item in self._store.get_all(services.kind)], response)
+
+    def _apply_changes(self, request: srv.ApplyChanges.Request,
+                       response: srv.ApplyChanges.Response) -> srv.ApplyChanges.Response:
+        batch_before = self._batch
+        self._writer = request.writer
+        try:
+            response = self._write(lambda: [convert.change_from_message(m) for m in request.changes],
+                                   response, keep_events=True)
+        finally:
+            self._writer = ""
+        response.batch = self._batch if self._batch != batch_before else 0
+        return response
+
+    def _new_symbol(self, request: srv.NewSymbol.Request,
+                    response: srv.NewSymbol.Response) -> srv.NewSymbol.Response:
+        try:
+            prefix = to_identifier(request.class_name)
+            response.index = self._store.next_symbol_index(prefix)
+            response.symbol = symbol(prefix, response.index)
+            response.success = True
+        except SailorError as error:
+            response.success, response.message = False, str(error)
+            self.get_logger().error(f"new_symbol for {request.class_name!r} refused: {error}")
+        return response
+
+    def _write(self, make_changes: Callable[[], list[Change]], response: Any,
+               keep_events: bool = False) -> Any:
+        """Apply a batch; a refused batch is reported in the response and logged, never raised."""
+        try:
+            events = self._store.apply(make_changes())
+        except SailorError as error:
+            response.success, response.message = False, str(error)
+            self.get_logger().warning(f"write refused: {error}")
+            return response
+        except Exception as error:  # a database failure must not take the node down
+            response.success, response.message = False, f"the store failed: {error}"
+            self.get_logger().error(f"the store failed to apply a batch: {error!r}")
+            return response
+        response.success = True
+        if keep_events:
+            response.events = [convert.event_to_message(event) for event in events]
+        return response
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return run_node(KnowledgeBaseNode, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,104 @@
+"""The knowledge_base node as a real process: other writers' changes, refusals, crash and restart."""
+
+from __future__ import annotations
+
+import random
+import threading
+import time
+import uuid
+
+import pytest
+
+from merlin2_sailor.errors import KnowledgeError
+from merlin2_sailor.knowledge import Change, PddlObject, PddlType, Predicate, Proposition, Provenance
+from merlin2_sailor.knowledge.stores import open_store
+
+pytestmark = pytest.mark.ros
+
+DECLARATIONS = [
+    Change.save(PddlType("cup")),
+    Change.save(Predicate("seen", ("cup",))),
+]
+
+
+def start_knowledge_base(node_process, namespace: str, store: str):
+    return node_process("knowledge_base", "--ros-args", "-r", f"__ns:={namespace}", "-p", f"store:={store}")
+
+
+def test_a_client_hears_other_writers_and_refusals_leave_the_node_running(node_process) -> None:
+    namespace = f"/kb_{uuid.uuid4().hex[:8]}"
+    process = start_knowledge_base(node_process, namespace, "memory")
+    writer, listener = open_store(f"ros://{namespace}"), open_store(f"ros://{namespace}")
+    try:
+        heard: list = []
+        listener.subscribe(heard.append)
+        writer.apply(DECLARATIONS)
+        writer.apply([Change.save(PddlObject("cup_1", "cup")),
+                      Change.save(Proposition("seen", ("cup_1",), provenance=Provenance.PERCEIVED))])
+        deadline = time.monotonic() + 10.0
+        while len(heard) < 2 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert [len(batch) for batch in heard] == [2, 2], heard
+        assert listener.propositions_about("cup_1") == (
+            Proposition("seen", ("cup_1",), provenance=Provenance.PERCEIVED),)
+
+        with pytest.raises(KnowledgeError, match="seen"):  # wrong arity: refused with the reason
+            writer.apply([Change.save(Proposition("seen", ("cup_1", "cup_1")))])
+        assert writer.objects.get("cup_1") == PddlObject("cup_1", "cup")  # still answering
+    finally:
+        writer.close()
+        listener.close()
+    assert process.stop() == 0, process.text
+    assert "write refused" in process.text
+
+
+def test_an_unreachable_knowledge_base_is_a_clear_error_not_a_hang() -> None:
+    with open_store(f"ros:///nobody_{uuid.uuid4().hex[:8]}") as store:
+        store._timeout = 0.5  # noqa: SLF001 - keep the test short
+        started = time.monotonic()
+        with pytest.raises(KnowledgeError, match="is the knowledge_base node running"):
+            store.objects.get_all()
+        assert time.monotonic() - started < 5.0
+
+
+def test_killed_at_random_moments_the_node_loses_no_acknowledged_write_and_reuses_no_symbol(
+    tmp_path, node_process
+) -> None:
+    namespace = f"/kb_{uuid.uuid4().hex[:8]}"
+    store = f"sqlite://{tmp_path / 'knowledge.db'}"
+    randomness = random.Random(7)
+    acknowledged: list[str] = []  # symbols whose object and fact the node confirmed
+    symbols: list[str] = []  # every symbol the node handed out
+    client = open_store(f"ros://{namespace}")
+    client._timeout = 3.0  # noqa: SLF001 - a killed node must not stall the test for long
+    try:
+        for _round in range(3):
+            process = start_knowledge_base(node_process, namespace, store)
+            client.apply(DECLARATIONS)
+            killer = threading.Timer(randomness.uniform(0.5, 1.5), process.process.kill)
+            killer.start()
+            while process.process.poll() is None:
+                try:
+                    symbol = client.new_symbol("cup")
+                    symbols.append(symbol)
+                    client.apply([Change.save(PddlObject(symbol, "cup")),
+                                  Change.save(Proposition("seen", (symbol,)))])
+                    acknowledged.append(symbol)
+                except KnowledgeError:
+                    break  # killed in the middle of a call: that write is not acknowledged
+            killer.join()
+            process.stop()
+        survivor = start_knowledge_base(node_process, namespace, store)
+        stored_objects = {item.name for item in client.objects.get_all()}
+        stored_facts = [fact.objects[0] for fact in client.propositions.get_all()]
+        next_symbol = client.new_symbol("cup")
+    finally:
+        client.close()
+    assert survivor.stop() == 0, survivor.text
+    assert len(acknowledged) >= 3
+    assert set(acknowledged) <= stored_objects  # nothing acknowledged is lost
+    assert stored_objects <= set(symbols)  # nothing appears that was never asked for
+    assert len(stored_facts) == len(set(stored_facts)) == len(stored_objects)  # no duplicate, no orphan
+    assert len(symbols) == len(set(symbols))  # no symbol handed out twice, across three crashes
+    indices = [int(symbol.rsplit("_", 1)[1]) for symbol in symbols + [next_symbol]]
+    assert indices == sorted(indices)
