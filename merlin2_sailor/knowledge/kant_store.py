@@ -1,0 +1,205 @@
+"""KantStore: MERLIN2's own knowledge base (KANT) as one more KnowledgeBase store.
+
+Where the real KANT Python packages are importable, SAILOR's anchors can be synchronised straight
+into MERLIN2's knowledge base: this adapter turns our model items into KANT's DTOs and drives
+KANT's data access objects (one per kind, each with get / get_all / save / delete / delete_all).
+
+KANT is shared with the rest of MERLIN2 (missions and actions write to it too), so unlike the
+local stores this one does not trust a mirror: it reloads KANT's content before every read and
+every batch, checks the batch with the same rules as every other store, and writes the net
+changes through the DAOs in dependency order. What KANT cannot hold is said plainly:
+
+* no transactions: a batch that fails half-way leaves the changes written so far (in dependency
+  order, so the knowledge base stays consistent);
+* no supertypes: types are flat, children of ``object``;
+* no provenance: facts this adapter wrote keep theirs while it runs; others read as DECLARED;
+* no symbol counter: the next index follows the highest one among KANT's objects and the ones
+  this adapter handed out, so a symbol deleted before a restart could be handed out again; use
+  the SQLite or MongoDB store where that guarantee matters.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+from collections.abc import Hashable, Iterable, Sequence
+from types import ModuleType
+from typing import Any
+
+from merlin2_sailor.errors import DependencyError, KnowledgeError
+from merlin2_sailor.knowledge import model
+from merlin2_sailor.knowledge.changes import ChangeEvent, ItemKind, Operation
+from merlin2_sailor.knowledge.mirrored_store import MirroredStore
+from merlin2_sailor.knowledge.model import KnowledgeItem, Proposition
+from merlin2_sailor.knowledge.rules import KnowledgeState
+
+
+def import_kant_dto() -> ModuleType:
+    try:
+        return importlib.import_module("kant_dto")
+    except ImportError as error:
+        raise DependencyError(
+            "the KANT store needs MERLIN2's kant_dto and kant_dao packages; build KANT in your "
+            "ROS 2 workspace (https://github.com/uleroboticsgroup/kant) and source it"
+        ) from error
+
+
+class KantStore(MirroredStore):
+    """A KnowledgeBase over KANT's DAOs, made by one of KANT's DAO factories.
+
+    ``dao_factory`` is what KANT's ``DaoFactoryMethod().create_dao_factory(family, ...)`` returns
+    (ROS 2 services of MERLIN2's KB node, or MongoDB); ``dto_module`` defaults to ``kant_dto``.
+    """
+
+    def __init__(self, dao_factory: Any, dto_module: ModuleType | None = None) -> None:
+        super().__init__()
+        self._dto = dto_module if dto_module is not None else import_kant_dto()
+        self._daos = {
+            ItemKind.TYPE: dao_factory.create_pddl_type_dao(),
+            ItemKind.OBJECT: dao_factory.create_pddl_object_dao(),
+            ItemKind.PREDICATE: dao_factory.create_pddl_predicate_dao(),
+            ItemKind.PROPOSITION: dao_factory.create_pddl_proposition_dao(),
+            ItemKind.ACTION: dao_factory.create_pddl_action_dao(),
+        }
+        self._provenances: dict[Hashable, model.Provenance] = {}
+        # Items of the batch being written, for DTOs of things the same batch deleted.
+        self._batch_items: dict[tuple[ItemKind, Hashable], KnowledgeItem] = {}
+        self._highest_index: dict[str, int] = {}
+        self._open_mirror()
+
+    # The port, reading KANT afresh each time.
+
+    def get(self, kind: ItemKind, key: Hashable) -> KnowledgeItem | None:
+        with self._lock:
+            self._reload()
+            return super().get(kind, key)
+
+    def get_all(self, kind: ItemKind) -> tuple[KnowledgeItem, ...]:
+        with self._lock:
+            self._reload()
+            return super().get_all(kind)
+
+    def propositions_about(self, object_name: str) -> tuple[Proposition, ...]:
+        with self._lock:
+            self._reload()
+            return super().propositions_about(object_name)
+
+    def apply(self, changes: Iterable[Any]) -> tuple[ChangeEvent, ...]:
+        with self._lock:
+            self._reload()
+            return super().apply(changes)
+
+    # What MirroredStore needs.
+
+    def _reload(self) -> None:
+        self._state = KnowledgeState()
+        self._state.load(self._load())
+
+    def _load(self) -> list[KnowledgeItem]:
+        items: list[KnowledgeItem] = []
+        for kind in (ItemKind.TYPE, ItemKind.OBJECT, ItemKind.PREDICATE, ItemKind.PROPOSITION, ItemKind.ACTION):
+            items.extend(self._from_dto(kind, dto) for dto in self._daos[kind].get_all() or [])
+        return items
+
+    def _persist(self, events: Sequence[ChangeEvent]) -> None:
+        self._batch_items = {(event.kind, getattr(event.item, "name", None)): event.item for event in events}
+        for event in events:
+            dao = self._daos[event.kind]
+            dto = self._to_dto(event.item)
+            written = dao.save(dto) if event.operation is Operation.SAVE else dao.delete(dto)
+            if written is False:
+                verb = "save" if event.operation is Operation.SAVE else "delete"
+                raise KnowledgeError(f"KANT refused to {verb} {event.kind.value} {event.item}")
+            if isinstance(event.item, Proposition):
+                if event.operation is Operation.SAVE:
+                    self._provenances[event.item.key] = event.item.provenance
+                else:
+                    self._provenances.pop(event.item.key, None)
+
+    def _reserve_symbol_index(self, class_identifier: str) -> int:
+        pattern = re.compile(rf"^{re.escape(class_identifier)}_(\d+)$")
+        in_kant = [int(match.group(1)) for obj in self._daos[ItemKind.OBJECT].get_all() or []
+                   if (match := pattern.match(obj.get_name()))]
+        index = max([self._highest_index.get(class_identifier, 0), *in_kant]) + 1
+        self._highest_index[class_identifier] = index
+        return index
+
+    def _close_database(self) -> None:
+        """KANT's DAOs hold no resources of ours."""
+
+    # Model items <-> KANT DTOs.
+
+    def _type_dto(self, name: str) -> Any:
+        return self._dto.PddlTypeDto(name)
+
+    def _stored(self, kind: ItemKind, name: str) -> Any:
+        return self._state.get(kind, name) or self._batch_items.get((kind, name))
+
+    def _object_dto(self, name: str) -> Any:
+        stored = self._stored(ItemKind.OBJECT, name)
+        if stored is None:
+            raise KnowledgeError(f"object {name!r} is not in the knowledge base")
+        return self._dto.PddlObjectDto(self._type_dto(stored.type), name)
+
+    def _predicate_dto(self, name: str) -> Any:
+        stored = self._stored(ItemKind.PREDICATE, name)
+        if stored is None:
+            raise KnowledgeError(f"predicate {name!r} is not in the knowledge base")
+        return self._dto.PddlPredicateDto(name, [self._type_dto(t) for t in stored.parameter_types])
+
+    def _to_dto(self, item: KnowledgeItem) -> Any:
+        if isinstance(item, model.PddlType):
+            return self._type_dto(item.name)
+        if isinstance(item, model.PddlObject):
+            return self._dto.PddlObjectDto(self._type_dto(item.type), item.name)
+        if isinstance(item, model.Predicate):
+            return self._dto.PddlPredicateDto(item.name, [self._type_dto(t) for t in item.parameter_types])
+        if isinstance(item, model.Proposition):
+            return self._dto.PddlPropositionDto(
+                self._predicate_dto(item.predicate), [self._object_dto(o) for o in item.objects], item.is_goal
+            )
+        return self._action_dto(item)  # type: ignore[arg-type]
+
+    def _action_dto(self, action: model.PddlAction) -> Any:
+        parameters = {p.name: self._dto.PddlObjectDto(self._type_dto(p.type), p.name) for p in action.parameters}
+
+        def literal(item: model.TimedLiteral) -> Any:
+            return self._dto.PddlConditionEffectDto(
+                self._predicate_dto(item.predicate), [parameters[name] for name in item.arguments],
+                item.time.value if item.time is not None else None, item.is_negative,
+            )
+
+        dto = self._dto.PddlActionDto(
+            action.name, list(parameters.values()), [literal(c) for c in action.conditions],
+            [literal(e) for e in action.effects], action.durative,
+        )
+        dto.set_duration(action.duration)
+        return dto
+
+    def _from_dto(self, kind: ItemKind, dto: Any) -> KnowledgeItem:
+        if kind is ItemKind.TYPE:
+            return model.PddlType(dto.get_name())
+        if kind is ItemKind.OBJECT:
+            return model.PddlObject(dto.get_name(), dto.get_type().get_name())
+        if kind is ItemKind.PREDICATE:
+            return model.Predicate(dto.get_name(), tuple(t.get_name() for t in dto.get_types()))
+        if kind is ItemKind.PROPOSITION:
+            proposition = model.Proposition(
+                dto.get_predicate().get_name(), tuple(o.get_name() for o in dto.get_objects()),
+                dto.get_is_goal(),
+            )
+            provenance = self._provenances.get(proposition.key, model.Provenance.DECLARED)
+            return model.Proposition(proposition.predicate, proposition.objects, proposition.is_goal, provenance)
+
+        def literal(item: Any, literal_class: type[model.TimedLiteral]) -> model.TimedLiteral:
+            return literal_class(item.get_predicate().get_name(), tuple(o.get_name() for o in item.get_objects()),
+                                 item.get_time() or None, item.get_is_negative())
+
+        return model.PddlAction(
+            name=dto.get_name(),
+            parameters=tuple(model.Parameter(p.get_name(), p.get_type().get_name()) for p in dto.get_parameters()),
+            conditions=tuple(literal(c, model.Condition) for c in dto.get_conditions()),
+            effects=tuple(literal(e, model.Effect) for e in dto.get_effects()),
+            durative=dto.get_durative(),
+            duration=float(dto.get_duration()) if dto.get_durative() else model.DEFAULT_ACTION_DURATION,
+        )
