@@ -29,6 +29,9 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
 os.environ.setdefault("ROS_LOG_DIR", tempfile.mkdtemp(prefix="sailor-test-ros-logs-"))
 os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "config" / "fastdds.xml"))
 os.environ.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
+# Nodes keep state under ~ (e.g. ~/.sailor/anchoring): tests must neither read a user's state
+# nor leave theirs behind, so this run gets a home of its own.
+os.environ["HOME"] = tempfile.mkdtemp(prefix="sailor-test-home-")
 
 # --- Fixtures for tests that talk to real nodes over DDS -----------------------------------
 # ros_probe gives a node spinning in a background thread of its own context and guarantees the

@@ -41,7 +41,12 @@ class KnowledgeSync:
     Not thread-safe: call :meth:`sync` from one thread (the node's knowledge timer).
     """
 
-    def __init__(self, store: KnowledgeBase, grounding: Grounding) -> None:
+    def __init__(
+        self, store: KnowledgeBase, grounding: Grounding, owned: Iterable[str] = ()
+    ) -> None:
+        """``owned`` names objects an earlier sync of the same anchors created (saved with the
+        anchors, see :attr:`owned_objects`): after a restart they are this sync's again, so an
+        anchor forgotten later still takes its object and facts with it."""
         self._store = store
         self._grounding = grounding
         self._managed_predicates = grounding.managed_predicates
@@ -56,7 +61,29 @@ class KnowledgeSync:
         # The store's facts of managed predicates about objects this sync grounds, any provenance.
         self._facts: dict[str, dict[PropositionKey, Proposition]] = {}
         self._last_heard: Sequence[ChangeEvent] = ()
+        for name in owned:
+            self._adopt(name)
         self._unsubscribe = store.subscribe(self._hear)
+
+    @property
+    def owned_objects(self) -> frozenset[str]:
+        """The objects this sync created and will delete when their anchors go; persist them."""
+        return frozenset(self._created)
+
+    def _adopt(self, name: str) -> None:
+        stored = self._store.objects.get(name)
+        if stored is None:
+            return
+        self._foreign_objects.discard(name)
+        self._created.add(name)
+        facts = {
+            fact.key: fact
+            for fact in self._store.propositions_about(name)
+            if not fact.is_goal and fact.predicate in self._managed_predicates
+        }
+        self._facts[name] = facts
+        perceived = frozenset(f for f in facts.values() if f.provenance is Provenance.PERCEIVED)
+        self._grounded[name] = GroundedAnchor(stored, perceived, visible=False)
 
     def plan(self, anchors: Iterable[GroundableAnchor]) -> SyncPlan:
         """The changes that would bring the store to these anchors; changes nothing itself."""

@@ -231,3 +231,25 @@ def test_sync_works_the_same_on_a_persistent_store(persistent_location, make_anc
 def test_events_report_the_change_kinds(sync, make_anchor):
     events = sync.sync([make_anchor("cup_1", "cup", 0, 0)])
     assert ChangeEvent(Operation.SAVE, ItemKind.OBJECT, PddlObject("cup_1", "object")) in events
+
+
+def test_after_a_restart_a_sync_that_owns_the_old_objects_still_cleans_them_up(
+    sync, mission_store, make_anchor
+):
+    sync.sync([make_anchor("cup_1", "cup", 0.2, 0), make_anchor("book_1", "book", 3, 0.3)])
+    owned = sync.owned_objects
+    assert owned == {"cup_1", "book_1"}
+    sync.close()  # the anchoring node crashed; its anchors come back from its snapshot
+
+    unaware = KnowledgeSync(mission_store, Grounding(GroundingConfig.from_mapping(MAP)))
+    assert not any(change.item == PddlObject("book_1", "object") for change in
+                   unaware.plan([make_anchor("cup_1", "cup", 0.2, 0)]).changes)
+    unaware.close()
+
+    restarted = KnowledgeSync(mission_store, Grounding(GroundingConfig.from_mapping(MAP)), owned=owned)
+    restarted.sync([make_anchor("cup_1", "cup", 0.2, 0)])  # book_1 was forgotten meanwhile
+    assert mission_store.objects.get("book_1") is None
+    assert facts_about(mission_store, "book_1") == set()
+    assert mission_store.objects.get("cup_1") == PddlObject("cup_1", "object")
+    assert mission_store.objects.get("rb1") == PddlObject("rb1", "robot")  # never ours
+    restarted.close()

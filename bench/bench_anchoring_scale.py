@@ -1,0 +1,141 @@
+"""Per-frame anchoring cost as anchors pile up far from the camera, and the memory they take.
+
+A robot that has mapped a large building keeps thousands of anchors, almost all of them far from
+where it looks now. The frame loop must not pay for them: gating and the visibility check ask a
+k-d tree for nearby anchors only. Scene: 20 objects 2-4 m in front of the camera, seen every
+frame (percepts with 1,280-d embeddings, a depth image for the occlusion test), plus N anchors
+acquired earlier 30-230 m away, each seen four times (full appearance galleries). The matcher is
+the rule matcher (the network's cost depends on the pairs that pass the gate, not on N; see
+bench_matching.py). Targets: per-frame cost flat within 2x from 100 to 10,000 far anchors;
+<= 300 MB for 10,000 anchors. One thread. Nothing is asserted.
+
+Run: python bench/bench_anchoring_scale.py
+"""
+
+# ruff: noqa: E402 - the thread limits must be set before NumPy and torch are imported
+from __future__ import annotations
+
+import os
+
+for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[variable] = "1"
+
+import gc
+import statistics
+import time
+import tracemalloc
+
+import numpy as np
+import torch
+from bench_matching import FEATURE_DIMENSION, GALLERY_VIEWS, machine_description
+
+from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, CameraView, LifecycleConfig, Percept
+from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.perception.camera_model import CameraIntrinsics
+from merlin2_sailor.perception.pose import Pose
+
+LOCAL_OBJECTS = 20
+FRAMES = 100
+INTRINSICS = CameraIntrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5, width=640, height=480)
+#: Camera at (0, 0, 1) looking along world +x (optical z forward, x right, y down).
+CAMERA = Pose(np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]), np.array([0.0, 0.0, 1.0]))
+
+
+def percept(
+    class_name: str, position: np.ndarray, embedding: np.ndarray, stamp: float, rng: np.random.Generator
+) -> Percept:
+    return Percept(
+        class_name=class_name,
+        score=0.8,
+        box=BoundingBox2D(320.0, 240.0, 60.0, 60.0),
+        position=position + rng.normal(scale=0.01, size=3),
+        size=np.array([0.2, 0.2, 0.3]),
+        stamp=stamp,
+        embedding=embedding + rng.normal(scale=0.01, size=embedding.shape).astype(np.float32),
+    )
+
+
+def acquire_far_anchors(anchoring: Anchoring, count: int, rng: np.random.Generator) -> float:
+    """Acquire ``count`` anchors 30-230 m away, each seen GALLERY_VIEWS times; returns the last stamp."""
+    positions = np.column_stack(
+        (rng.uniform(30.0, 230.0, count), rng.uniform(-100.0, 100.0, count), rng.uniform(0.0, 2.0, count))
+    )
+    embeddings = rng.random((count, FEATURE_DIMENSION), dtype=np.float32)
+    stamp = 0.0
+    for start in range(0, count, 200):
+        batch = range(start, min(start + 200, count))
+        for _ in range(GALLERY_VIEWS):
+            stamp += 0.1
+            percepts = [percept(f"class_{i % 50}", positions[i], embeddings[i], stamp, rng) for i in batch]
+            anchoring.process(percepts, None, stamp)
+    return stamp
+
+
+def new_anchoring() -> Anchoring:
+    # the far anchors are acquired without a camera view, so they are never "missing"; keep them
+    return Anchoring(AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=GALLERY_VIEWS)))
+
+
+def frame_cost_ms(far_anchors: int, rng: np.random.Generator) -> tuple[float, int]:
+    anchoring = new_anchoring()
+    stamp = acquire_far_anchors(anchoring, far_anchors, rng)
+    local_positions = np.column_stack(
+        [rng.uniform(low, high, LOCAL_OBJECTS) for low, high in ((2.0, 4.0), (-1.0, 1.0), (0.5, 1.5))]
+    )
+    local_embeddings = rng.random((LOCAL_OBJECTS, FEATURE_DIMENSION), dtype=np.float32)
+    view = CameraView(INTRINSICS, CAMERA, np.full((INTRINSICS.height, INTRINSICS.width), 5.0, dtype=np.float32))
+    times = []
+    for frame in range(FRAMES + 5):
+        stamp += 1.0 / 15.0
+        percepts = [
+            percept(f"class_{i}", local_positions[i], local_embeddings[i], stamp, rng) for i in range(LOCAL_OBJECTS)
+        ]
+        start = time.perf_counter()
+        anchoring.process(percepts, view, stamp)
+        if frame >= 5:  # the first frames acquire the local objects
+            times.append(time.perf_counter() - start)
+    return statistics.median(times) * 1e3, len(anchoring)
+
+
+def memory_of_anchors(count: int, rng: np.random.Generator) -> tuple[float, float, int]:
+    """(tracemalloc MB, RSS growth MB, anchors) of an Anchoring acquiring ``count`` far objects.
+
+    A few random objects fall within a few centimetres of one of their class and are (rightly)
+    anchored as one, so the anchor count can be slightly below ``count``.
+    """
+    gc.collect()
+    rss_before = resident_mb()
+    tracemalloc.start()
+    anchoring = new_anchoring()
+    acquire_far_anchors(anchoring, count, rng)
+    gc.collect()
+    traced, _peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    rss_growth = resident_mb() - rss_before
+    return traced / 2**20, rss_growth, len(anchoring)
+
+
+def resident_mb() -> float:
+    with open("/proc/self/statm") as statm:
+        return int(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+def main() -> None:
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(0)
+    print(machine_description())
+    print(f"{LOCAL_OBJECTS} percepts per frame near the camera, far anchors 30-230 m away, rule matcher, "
+          f"depth image {INTRINSICS.width}x{INTRINSICS.height}; median of {FRAMES} frames")
+    # memory first, while the process has not yet grown its heap: the RSS growth is then meaningful
+    traced, rss, anchors = memory_of_anchors(10_000, rng)
+    print(f"memory for {anchors:,} anchors with {GALLERY_VIEWS}-view {FEATURE_DIMENSION}-d galleries: "
+          f"{traced:.0f} MB traced, {rss:.0f} MB RSS growth (target <= 300 MB)")
+    costs = {}
+    for count in (100, 1_000, 10_000):
+        costs[count], total = frame_cost_ms(count, rng)
+        print(f"{count:>6} far objects ({total:>6} anchors in all): {costs[count]:6.2f} ms/frame")
+    print(f"slowest / fastest: {max(costs.values()) / min(costs.values()):.2f}x (target: within 2x)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,127 @@
+"""The anchor: the link between one physical object, its percepts and its symbol.
+
+An anchor is the anchoring layer's memory of one object: where it is (world frame), how big,
+what it looks like (a small gallery of embeddings), what class the detector thinks it is, when
+it was seen, and how much to trust it (:class:`AnchorState`). It satisfies the knowledge layer's
+``GroundableAnchor`` / ``SizedAnchor`` protocols structurally, so grounding reads it directly.
+
+Anchors are owned and mutated by :class:`~merlin2_sailor.anchoring.anchoring.Anchoring` only;
+callers read them. Fusion rules live in :mod:`.fusion`, lifecycle rules in :mod:`.lifecycle`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
+from merlin2_sailor.anchoring.gallery import add_to_gallery
+from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.knowledge.model import Provenance
+
+
+class AnchorState(Enum):
+    """How much an anchor is trusted; the values are what grounding configuration names."""
+
+    TENTATIVE = "tentative"
+    """Seen fewer times than needed to be trusted; a spurious detection stays here and fades."""
+    CONFIRMED = "confirmed"
+    """Seen often enough to stand for a real object."""
+    MISSING = "missing"
+    """Should have been seen (in view, not occluded) and was not; kept a while, in case."""
+    FORGOTTEN = "forgotten"
+    """Missing too long or forgotten on request; no longer anchored."""
+
+
+def _zero_vector() -> np.ndarray:
+    return np.zeros(3)
+
+
+@dataclass(slots=True, eq=False)
+class Anchor:
+    """One anchored object. Positions and sizes are (3,) float64 metres in the world frame."""
+
+    symbol: str
+    class_name: str
+    position: np.ndarray
+    size: np.ndarray
+    first_seen: float
+    last_seen: float
+    state: AnchorState = AnchorState.TENTATIVE
+    times_seen: int = 1
+    last_tracker_id: str = ""
+    """The tracker id of the latest percept that carried one; empty when none ever did."""
+    class_votes: dict[str, float] = field(default_factory=dict)
+    position_variance: float = 0.01
+    gallery: np.ndarray | None = None
+    """(n, D) recent appearance embeddings as bfloat16 bits (:mod:`.gallery`), newest last; None
+    before any was available."""
+    visible: bool = False
+    """Reacquired or acquired in the latest processed frame."""
+    missed_frames: int = 0
+    """Consecutive frames in which it should have been visible and was not reacquired."""
+    missing_since: float | None = None
+    provenance: Provenance = Provenance.PERCEIVED
+    """PERCEIVED when ``position`` comes from the camera, EXPECTED when from an action's effect."""
+    perceived_position: np.ndarray = field(default_factory=_zero_vector)
+    """The latest position perception gave, to fall back to when an expectation is retracted."""
+    expectation: Expectation | None = None
+    expectation_confirmed: bool = False
+
+    @property
+    def confidence(self) -> float:
+        """A [0, 1] summary for people and planners: grows with the percepts fused (0.63 after
+        three, 0.95 after nine) and halves while the anchor is missing."""
+        observed = 1.0 - math.exp(-self.times_seen / 3.0)
+        return observed * (0.5 if self.state is AnchorState.MISSING else 1.0)
+
+    @classmethod
+    def from_percept(
+        cls, symbol: str, percept: Percept, embedding: np.ndarray | None, config: FusionConfig
+    ) -> Anchor:
+        """Acquire: a new, tentative anchor initialised from one percept."""
+        position = np.array(percept.position, dtype=np.float64)
+        return cls(
+            symbol=symbol,
+            class_name=percept.class_name,
+            position=position,
+            size=np.array(percept.size, dtype=np.float64),
+            first_seen=percept.stamp,
+            last_seen=percept.stamp,
+            last_tracker_id=percept.tracker_id,
+            class_votes=vote_class({}, percept.class_name, percept.score),
+            position_variance=config.initial_variance,
+            gallery=None if embedding is None else add_to_gallery(None, embedding, config.gallery_size),
+            visible=True,
+            perceived_position=position.copy(),
+        )
+
+    def absorb(self, percept: Percept, embedding: np.ndarray | None, config: FusionConfig) -> None:
+        """Reacquire: fuse one more percept of this object into the anchor (never overwrite)."""
+        self.times_seen += 1
+        self.position, self.position_variance = fuse_position(
+            self.position, self.position_variance, percept.position, percept.stamp - self.last_seen, config
+        )
+        self.size = fuse_size(self.size, percept.size, self.times_seen, config)
+        self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
+        self.class_name = winning_class(self.class_votes, self.class_name)
+        if embedding is not None:
+            self.gallery = add_to_gallery(self.gallery, embedding, config.gallery_size)
+        if percept.tracker_id:
+            self.last_tracker_id = percept.tracker_id
+        self.last_seen = max(self.last_seen, percept.stamp)
+        self.perceived_position = self.position.copy()
+        self.provenance = Provenance.PERCEIVED
+        self.visible = True
+        self.missed_frames = 0
+        self.missing_since = None
+
+    @property
+    def is_active(self) -> bool:
+        """Not forgotten: still anchored and matchable."""
+        return self.state is not AnchorState.FORGOTTEN

@@ -1,0 +1,36 @@
+"""AnchorView: an immutable copy of what other threads may read of an anchor.
+
+The anchoring core mutates anchors in place on every frame. The knowledge-base sync and the
+state file run off the perception hot path, in another thread, so they get frozen copies taken
+under the node's lock, never the live anchors. A view satisfies the grounding protocols
+(``GroundableAnchor`` and ``SizedAnchor``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+
+
+@dataclass(frozen=True, eq=False)
+class AnchorView:
+    symbol: str
+    class_name: str
+    position: np.ndarray
+    size: np.ndarray
+    state: AnchorState
+    visible: bool
+
+    @classmethod
+    def of(cls, anchor: Anchor) -> AnchorView:
+        position, size = anchor.position.copy(), anchor.size.copy()
+        position.flags.writeable = size.flags.writeable = False
+        return cls(anchor.symbol, anchor.class_name, position, size, anchor.state, anchor.visible)
+
+
+def views_of(anchors: Iterable[Anchor]) -> list[AnchorView]:
+    return [AnchorView.of(anchor) for anchor in anchors]

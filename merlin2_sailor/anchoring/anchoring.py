@@ -1,0 +1,504 @@
+"""The anchoring process: acquire, reacquire, track and find, with the anchor lifecycle.
+
+One frame (:meth:`Anchoring.process`) follows the paper's algorithm, then the lifecycle:
+
+1. anchors missing for too long are forgotten;
+2. with no anchors, every percept is acquired; otherwise the matching table (gated, batched) is
+   built and assigned: a pair at or above ``match_threshold`` reacquires (the anchor fuses the
+   percept), every other percept acquires a new anchor with a fresh symbol;
+3. an anchor not reacquired is checked against the camera: only if it should have been visible
+   (in the frustum, not occluded by nearer depth) does it count towards MISSING; an anchor with
+   an expected location seen empty has that expectation RETRACTED instead.
+
+:meth:`Anchoring.track` moves anchors without observation (static objects stay put; carried ones
+follow the robot) and applies time-outs; :meth:`Anchoring.expect` records an action's expected
+effect; :meth:`Anchoring.find` answers top-down queries; :meth:`Anchoring.snapshot` /
+:meth:`Anchoring.restore` carry anchors across restarts.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex, IndexConfig
+from merlin2_sailor.anchoring.assignment import assign
+from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
+from merlin2_sailor.anchoring.expectation import Expectation, ExpectationKind
+from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_expected_but_unseen, after_sighting, expire
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.matching_table import Embedder, MatchingTableBuilder, MatchingTableConfig, with_embeddings
+from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+from merlin2_sailor.anchoring.snapshot import SNAPSHOT_FORMAT, SNAPSHOT_VERSION, anchor_from_dict, anchor_to_dict
+from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
+from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig, should_be_visible
+from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
+from merlin2_sailor.knowledge.model import Provenance
+from merlin2_sailor.perception.pose import Pose
+
+#: find() prefers anchors in this order of state.
+_FIND_STATE_RANK = {AnchorState.CONFIRMED: 0, AnchorState.TENTATIVE: 1, AnchorState.MISSING: 2}
+
+
+@dataclass(frozen=True, slots=True)
+class AnchoringConfig:
+    """Everything the anchoring core can be tuned with; every part validates itself.
+
+    ``match_threshold``: the score a pair needs to reacquire (the paper's 0.5);
+    ``world_frame``: the fixed frame percepts must be expressed in;
+    ``expectation_tolerance`` (m): how close to an expected place a reacquired object must be
+    to confirm the expectation (farther retracts it).
+    """
+
+    match_threshold: float = 0.5
+    world_frame: str = "map"
+    expectation_tolerance: float = 1.0
+    table: MatchingTableConfig = field(default_factory=MatchingTableConfig)
+    fusion: FusionConfig = field(default_factory=FusionConfig)
+    lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
+    visibility: VisibilityConfig = field(default_factory=VisibilityConfig)
+    index: IndexConfig = field(default_factory=IndexConfig)
+
+    def __post_init__(self) -> None:
+        if not (0.0 < self.match_threshold <= 1.0):
+            raise ConfigurationError(f"anchoring match_threshold must be in (0, 1], got {self.match_threshold}.")
+        if not self.world_frame:
+            raise ConfigurationError("anchoring world_frame must name the fixed frame (e.g. map or odom).")
+        if not (math.isfinite(self.expectation_tolerance) and self.expectation_tolerance > 0.0):
+            raise ConfigurationError(
+                "anchoring expectation_tolerance must be a positive number of metres, "
+                f"got {self.expectation_tolerance}."
+            )
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class AnchoringResult:
+    """What one call changed. ``percept_symbols[i]`` is the symbol percept i was anchored to."""
+
+    stamp: float
+    acquired: tuple[Anchor, ...] = ()
+    reacquired: tuple[Anchor, ...] = ()
+    missing: tuple[Anchor, ...] = ()
+    forgotten: tuple[Anchor, ...] = ()
+    events: tuple[AnchorEvent, ...] = ()
+    percept_symbols: tuple[str, ...] = ()
+
+
+@dataclass(slots=True)
+class _Changes:
+    """Collects one call's changes in order, then freezes them into an :class:`AnchoringResult`."""
+
+    stamp: float
+    acquired: list[Anchor] = field(default_factory=list)
+    reacquired: list[Anchor] = field(default_factory=list)
+    missing: list[Anchor] = field(default_factory=list)
+    forgotten: list[Anchor] = field(default_factory=list)
+    events: list[AnchorEvent] = field(default_factory=list)
+
+    def event(self, kind: AnchorEventKind, symbol: str, **details: Any) -> None:
+        self.events.append(AnchorEvent(kind, symbol, self.stamp, details))
+
+    def result(self, percept_symbols: Sequence[str] = ()) -> AnchoringResult:
+        return AnchoringResult(
+            self.stamp,
+            tuple(self.acquired),
+            tuple(self.reacquired),
+            tuple(self.missing),
+            tuple(self.forgotten),
+            tuple(self.events),
+            tuple(percept_symbols),
+        )
+
+
+class Anchoring:
+    """The ROS-free anchoring core; a node feeds it percepts and camera views and publishes results.
+
+    ``matcher`` defaults to the :class:`~.rule_matcher.RuleMatcher` (a trained
+    :class:`~.matching_network.NetworkMatcher` plugs in the same way); ``embedder`` embeds crops
+    when the matcher uses appearance; ``symbol_factory`` names new anchors, normally
+    ``KnowledgeBase.new_symbol`` so that symbols are never reused, even across restarts.
+
+    Typical node loop::
+
+        anchoring = Anchoring(config, matcher, embedder, knowledge_base.new_symbol)
+        result = anchoring.process(percepts, CameraView(intrinsics, camera_to_world, depth), stamp)
+        publish(result.events)            # and ground result.acquired / reacquired / forgotten
+        anchoring.track(now, robot_pose)  # on a timer: carried objects, time-outs
+
+    Not thread-safe: call it from one thread (one callback group in a node).
+    """
+
+    def __init__(
+        self,
+        config: AnchoringConfig | None = None,
+        matcher: Matcher | None = None,
+        embedder: Embedder | None = None,
+        symbol_factory: SymbolFactory | None = None,
+    ) -> None:
+        self.config = config or AnchoringConfig()
+        self.matcher = matcher or RuleMatcher()
+        self.embedder = embedder
+        counter = SymbolCounter()
+        self._own_counter: SymbolCounter | None = counter if symbol_factory is None else None
+        self._new_symbol: SymbolFactory = symbol_factory or counter
+        self._table_builder = MatchingTableBuilder(self.matcher, self.config.table, embedder)
+        self._index = AnchorIndex(self.config.index)
+        self._by_class: dict[str, set[str]] = {}
+        self._missing: set[str] = set()
+        self._expected: set[str] = set()
+        self._visible: set[str] = set()
+        self._latest_stamp = -math.inf
+
+    # --- reading ----------------------------------------------------------------------------
+
+    def __len__(self) -> int:
+        return len(self._index)
+
+    def __contains__(self, symbol: object) -> bool:
+        return symbol in self._index
+
+    @property
+    def anchors(self) -> tuple[Anchor, ...]:
+        """Every anchor not forgotten. Read them; change them only through this class."""
+        return tuple(self._index)
+
+    def get(self, symbol: str) -> Anchor | None:
+        return self._index.get(symbol)
+
+    def find(
+        self, symbol: str | None = None, class_name: str | None = None, near: np.ndarray | None = None
+    ) -> Anchor | None:
+        """Top-down Find: the best anchor for a symbol, or for a class (optionally nearest a point).
+
+        Among candidates, CONFIRMED beats TENTATIVE beats MISSING; then, if ``near`` is given, the
+        nearest wins; then the most recently seen.
+        """
+        if symbol is not None:
+            anchor = self._index.get(symbol)
+            return None if anchor is None or (class_name is not None and anchor.class_name != class_name) else anchor
+        if class_name is None and near is None:
+            raise InvalidInputError("find() needs a symbol, a class name or a point to search near.")
+        if class_name is not None:
+            candidates = [self._index.get(name) for name in self._by_class.get(class_name, ())]
+        else:
+            candidates = list(self._index)
+        point = None if near is None else _point(near, "near")
+
+        def preference(anchor: Anchor | None) -> tuple[float, float, float, str]:
+            assert anchor is not None
+            distance = 0.0 if point is None else float(np.linalg.norm(anchor.position - point))
+            return (_FIND_STATE_RANK.get(anchor.state, 3), distance, -anchor.last_seen, anchor.symbol)
+
+        return min(candidates, key=preference, default=None)
+
+    # --- the frame loop ---------------------------------------------------------------------
+
+    def process(self, percepts: Sequence[Percept], camera: CameraView | None, stamp: float) -> AnchoringResult:
+        """Anchor one frame's percepts; ``camera`` (or None) says what the camera could see."""
+        self._check_percepts(percepts, stamp)
+        changes = _Changes(stamp)
+        self._latest_stamp = max(self._latest_stamp, stamp)
+        self._expire_missing(changes)
+
+        table = self._table_builder.build(percepts, self._index)
+        percepts = table.percepts
+        assignment = assign(table.scores, self.config.match_threshold)
+        symbols = [""] * len(percepts)
+        seen: set[str] = set()
+        for row, column in assignment.matches:
+            anchor = table.anchors[column]
+            self._reacquire(anchor, percepts[row], changes, continued=bool(table.continuations[row, column]))
+            symbols[row] = anchor.symbol
+            seen.add(anchor.symbol)
+
+        unmatched = [int(row) for row in assignment.unmatched_percepts]
+        percepts = self._embed_for_gallery(percepts, unmatched)
+        for row in unmatched:
+            anchor = self._acquire(percepts[row], changes)
+            symbols[row] = anchor.symbol
+            seen.add(anchor.symbol)
+
+        if camera is not None:
+            self._check_unseen(camera, seen, changes)
+        for symbol in self._visible - seen:
+            anchor = self._index.get(symbol)
+            if anchor is not None:
+                anchor.visible = False
+        self._visible = seen
+        return changes.result(symbols)
+
+    def track(self, stamp: float, robot_pose: Pose | None = None) -> AnchoringResult:
+        """Extend anchors without observation and apply the lifecycle's time-outs.
+
+        Static objects stay where they were seen; an object expected to be carried follows
+        ``robot_pose`` (the robot base in the world frame) while the camera does not see it.
+        """
+        changes = _Changes(stamp)
+        self._latest_stamp = max(self._latest_stamp, stamp)
+        for symbol in sorted(self._expected):
+            anchor = self._index.get(symbol)
+            if anchor is None or anchor.expectation is None or anchor.visible:
+                continue
+            position = anchor.expectation.expected_position(robot_pose)
+            if position is not None:
+                self._move_to_expected(anchor, position)
+        self._expire_missing(changes)
+        return changes.result()
+
+    # --- expected effects -------------------------------------------------------------------
+
+    def expect(self, symbol: str, expectation: Expectation, robot_pose: Pose | None = None) -> None:
+        """Record where an action expects an anchored object to be (provenance EXPECTED).
+
+        The anchor moves there at once (a carried one when a robot pose is known) so gating and
+        Find look in the right place; perception then confirms or retracts it.
+        """
+        anchor = self._require(symbol)
+        anchor.expectation = expectation
+        anchor.expectation_confirmed = False
+        anchor.missed_frames = 0
+        self._expected.add(symbol)
+        position = expectation.expected_position(robot_pose)
+        if position is not None:
+            self._move_to_expected(anchor, position)
+
+    def clear_expectation(self, symbol: str) -> None:
+        """Drop an expectation that no longer applies (e.g. the carrying action ended)."""
+        anchor = self._require(symbol)
+        anchor.expectation = None
+        anchor.expectation_confirmed = False
+        self._expected.discard(symbol)
+
+    # --- forgetting, snapshots --------------------------------------------------------------
+
+    def forget(self, symbol: str, stamp: float | None = None) -> AnchorEvent:
+        """Forget an anchor on request; returns the FORGOTTEN event for the caller to publish."""
+        anchor = self._require(symbol)
+        anchor.state = AnchorState.FORGOTTEN
+        self._remove(anchor)
+        when = self._latest_stamp if stamp is None else stamp
+        when = when if math.isfinite(when) else 0.0  # nothing processed yet: no better time to give
+        return AnchorEvent(AnchorEventKind.FORGOTTEN, symbol, when, {"reason": "requested"})
+
+    def snapshot(self) -> dict[str, Any]:
+        """Every anchor as plain, JSON-safe data (see :mod:`.snapshot`)."""
+        return {
+            "format": SNAPSHOT_FORMAT,
+            "version": SNAPSHOT_VERSION,
+            "world_frame": self.config.world_frame,
+            "stamp": self._latest_stamp if math.isfinite(self._latest_stamp) else None,
+            "anchors": [anchor_to_dict(anchor) for anchor in sorted(self._index, key=lambda a: a.symbol)],
+        }
+
+    def restore(self, snapshot: Mapping[str, Any]) -> None:
+        """Replace every anchor by those of a snapshot (after a restart, before any frame)."""
+        if not isinstance(snapshot, Mapping) or snapshot.get("format") != SNAPSHOT_FORMAT:
+            raise InvalidInputError(f"Not an anchors snapshot (expected format {SNAPSHOT_FORMAT!r}).")
+        if snapshot.get("version") != SNAPSHOT_VERSION:
+            raise InvalidInputError(
+                f"Anchors snapshot version {snapshot.get('version')!r} is not supported "
+                f"(this code reads version {SNAPSHOT_VERSION})."
+            )
+        if snapshot.get("world_frame", self.config.world_frame) != self.config.world_frame:
+            raise InvalidInputError(
+                f"The snapshot's anchors are in frame {snapshot['world_frame']!r}, this core anchors in "
+                f"{self.config.world_frame!r}; positions would be meaningless."
+            )
+        anchors = [anchor_from_dict(data) for data in snapshot.get("anchors", ())]
+        symbols = [anchor.symbol for anchor in anchors]
+        if len(set(symbols)) != len(symbols):
+            raise InvalidInputError("The anchors snapshot names a symbol twice.")
+        self._index.clear()
+        self._by_class.clear()
+        self._missing.clear()
+        self._expected.clear()
+        self._visible.clear()
+        for anchor in anchors:
+            if anchor.state is not AnchorState.FORGOTTEN:
+                self._insert(anchor)
+        self._index.rebuild()
+        if snapshot.get("stamp") is not None:
+            self._latest_stamp = max(self._latest_stamp, float(snapshot["stamp"]))
+        if self._own_counter is not None:
+            self._own_counter.note_used(symbols)
+
+    # --- internals: acquire / reacquire -----------------------------------------------------
+
+    def _acquire(self, percept: Percept, changes: _Changes) -> Anchor:
+        symbol = self._new_symbol(percept.class_name)
+        if symbol in self._index:
+            raise SailorError(
+                f"The symbol factory returned {symbol!r}, which already names an anchor; it must never reuse a "
+                "symbol (use a persistent counter such as KnowledgeBase.new_symbol)."
+            )
+        anchor = Anchor.from_percept(symbol, percept, percept.embedding, self.config.fusion)
+        became_confirmed = after_sighting(anchor, self.config.lifecycle)
+        self._insert(anchor)
+        changes.acquired.append(anchor)
+        changes.event(AnchorEventKind.ACQUIRED, symbol, class_name=anchor.class_name, tracker_id=percept.tracker_id)
+        if became_confirmed:
+            changes.event(AnchorEventKind.CONFIRMED, symbol, reason="seen", times_seen=anchor.times_seen)
+        return anchor
+
+    def _reacquire(self, anchor: Anchor, percept: Percept, changes: _Changes, continued: bool) -> None:
+        if anchor.expectation is not None:
+            self._resolve_expectation(anchor, percept, changes)
+        was_missing = anchor.state is AnchorState.MISSING
+        old_class = anchor.class_name
+        anchor.absorb(percept, percept.embedding, self.config.fusion)
+        became_confirmed = after_sighting(anchor, self.config.lifecycle)
+        self._missing.discard(anchor.symbol)
+        self._index.refresh(anchor)
+        if anchor.class_name != old_class:
+            self._by_class[old_class].discard(anchor.symbol)
+            self._by_class.setdefault(anchor.class_name, set()).add(anchor.symbol)
+        changes.reacquired.append(anchor)
+        changes.event(
+            AnchorEventKind.REACQUIRED,
+            anchor.symbol,
+            was_missing=was_missing,
+            tracker_id=percept.tracker_id,
+            tracker_continued=continued,
+        )
+        if became_confirmed:
+            changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="seen", times_seen=anchor.times_seen)
+
+    def _resolve_expectation(self, anchor: Anchor, percept: Percept, changes: _Changes) -> None:
+        """Perception outranks expectation: seen near the expected place confirms, elsewhere retracts."""
+        expectation = anchor.expectation
+        assert expectation is not None
+        distance = float(np.linalg.norm(np.asarray(percept.position) - anchor.position))
+        details = {"expectation": expectation.describe(), "distance": distance}
+        if distance > self.config.expectation_tolerance:
+            changes.event(AnchorEventKind.RETRACTED, anchor.symbol, reason="seen elsewhere", **details)
+            self._drop_expectation(anchor)
+            anchor.position = anchor.perceived_position.copy()
+            return
+        if not anchor.expectation_confirmed:
+            changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="expectation", **details)
+        if expectation.kind is ExpectationKind.CARRIED:
+            anchor.expectation_confirmed = True  # still carried: keep following the robot
+        else:
+            self._drop_expectation(anchor)
+
+    def _embed_for_gallery(self, percepts: tuple[Percept, ...], rows: list[int]) -> tuple[Percept, ...]:
+        """Embed new anchors' crops (not yet embedded) so their galleries can be matched later."""
+        if not self.matcher.uses_appearance or self.embedder is None:
+            return percepts
+        needed = [row for row in rows if percepts[row].embedding is None and percepts[row].crop.size > 0]
+        return with_embeddings(percepts, needed, self.embedder) if needed else percepts
+
+    # --- internals: lifecycle ---------------------------------------------------------------
+
+    def _check_unseen(self, camera: CameraView, seen: set[str], changes: _Changes) -> None:
+        """Count anchors that should have been seen but were not; retract expectations seen empty."""
+        slots = self._index.within(camera.position.reshape(1, 3), _frustum_reach(camera, self.config.visibility))[0]
+        anchors = [anchor for anchor in self._index.anchors_at(slots) if anchor.symbol not in seen]
+        if not anchors:
+            return
+        visible = should_be_visible(
+            np.array([a.position for a in anchors]), np.array([a.size for a in anchors]), camera, self.config.visibility
+        )
+        for anchor in (a for a, expected in zip(anchors, visible, strict=True) if expected):
+            if anchor.expectation is not None:
+                changes.event(
+                    AnchorEventKind.RETRACTED,
+                    anchor.symbol,
+                    reason="expected place seen empty",
+                    expectation=anchor.expectation.describe(),
+                )
+                self._drop_expectation(anchor)
+                anchor.position = anchor.perceived_position.copy()
+                self._index.refresh(anchor)
+            elif after_expected_but_unseen(anchor, changes.stamp, self.config.lifecycle):
+                self._missing.add(anchor.symbol)
+                changes.missing.append(anchor)
+                changes.event(AnchorEventKind.MISSING, anchor.symbol, missed_frames=anchor.missed_frames)
+
+    def _expire_missing(self, changes: _Changes) -> None:
+        for symbol in sorted(self._missing):
+            anchor = self._index.get(symbol)
+            if anchor is not None and expire(anchor, changes.stamp, self.config.lifecycle):
+                self._remove(anchor)
+                changes.forgotten.append(anchor)
+                changes.event(
+                    AnchorEventKind.FORGOTTEN, symbol, reason="missing too long", missing_since=anchor.missing_since
+                )
+
+    # --- internals: bookkeeping -------------------------------------------------------------
+
+    def _move_to_expected(self, anchor: Anchor, position: np.ndarray) -> None:
+        anchor.position = np.asarray(position, dtype=np.float64)
+        anchor.position_variance = self.config.expectation_tolerance**2
+        anchor.provenance = Provenance.EXPECTED
+        self._index.refresh(anchor)
+
+    def _drop_expectation(self, anchor: Anchor) -> None:
+        anchor.expectation = None
+        anchor.expectation_confirmed = False
+        anchor.provenance = Provenance.PERCEIVED
+        self._expected.discard(anchor.symbol)
+
+    def _insert(self, anchor: Anchor) -> None:
+        self._index.add(anchor)
+        self._by_class.setdefault(anchor.class_name, set()).add(anchor.symbol)
+        if anchor.state is AnchorState.MISSING:
+            self._missing.add(anchor.symbol)
+        if anchor.expectation is not None:
+            self._expected.add(anchor.symbol)
+        if anchor.visible:
+            self._visible.add(anchor.symbol)
+
+    def _remove(self, anchor: Anchor) -> None:
+        self._index.remove(anchor.symbol)
+        self._by_class.get(anchor.class_name, set()).discard(anchor.symbol)
+        self._missing.discard(anchor.symbol)
+        self._expected.discard(anchor.symbol)
+        self._visible.discard(anchor.symbol)
+        anchor.visible = False
+
+    def _require(self, symbol: str) -> Anchor:
+        anchor = self._index.get(symbol)
+        if anchor is None:
+            raise InvalidInputError(f"No anchor is named {symbol!r}; it was never acquired or has been forgotten.")
+        return anchor
+
+    def _check_percepts(self, percepts: Iterable[Percept], stamp: float) -> None:
+        if not math.isfinite(stamp):
+            raise InvalidInputError(f"The frame stamp must be finite, got {stamp}.")
+        for number, percept in enumerate(percepts):
+            if percept.frame_id != self.config.world_frame:
+                raise InvalidInputError(
+                    f"Percept {number} ({percept.class_name}) is in frame {percept.frame_id!r}, but anchors live in "
+                    f"{self.config.world_frame!r}; transform percepts with the camera pose at the image stamp first."
+                )
+            _point(percept.position, f"percept {number} position")
+            size = np.asarray(percept.size, dtype=np.float64).reshape(-1)
+            if size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size < 0.0):
+                raise InvalidInputError(
+                    f"Percept {number} size must be 3 finite non-negative numbers, got {size.tolist()}."
+                )
+            if not math.isfinite(percept.stamp):
+                raise InvalidInputError(f"Percept {number} has a non-finite stamp {percept.stamp}.")
+
+
+def _point(values: Any, name: str) -> np.ndarray:
+    point = np.asarray(values, dtype=np.float64).reshape(-1)
+    if point.shape != (3,) or not np.all(np.isfinite(point)):
+        raise InvalidInputError(f"{name} must be 3 finite coordinates, got {np.asarray(values).tolist()}.")
+    return point
+
+
+def _frustum_reach(camera: CameraView, config: VisibilityConfig) -> float:
+    """The largest distance from the optical centre of any point inside the frustum."""
+    intrinsics = camera.intrinsics
+    half_width = max(intrinsics.cx, intrinsics.width - intrinsics.cx) / intrinsics.fx
+    half_height = max(intrinsics.cy, intrinsics.height - intrinsics.cy) / intrinsics.fy
+    return config.frustum.far * math.sqrt(1.0 + half_width**2 + half_height**2)

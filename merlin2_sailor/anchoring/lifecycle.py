@@ -1,0 +1,88 @@
+"""The anchor lifecycle: tentative -> confirmed -> missing -> forgotten, and back from missing.
+
+The original SAILOR kept every anchor forever and could not tell "not seen" from "gone". Here an
+anchor earns trust by being seen (``confirm_after`` percepts), loses it only when it *should*
+have been seen (in the camera frustum and not occluded: the caller decides that) for
+``missed_frames_to_missing`` consecutive frames, and is forgotten after ``forget_after`` seconds
+missing. Anchors never confirmed are forgotten sooner (``forget_tentative_after``): most of them
+are spurious detections, and keeping them would let false positives pile up. Reacquiring a
+missing anchor restores it.
+
+Each function changes one anchor and returns whether its state changed, so the caller emits the
+matching event.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.errors import ConfigurationError
+
+
+@dataclass(frozen=True, slots=True)
+class LifecycleConfig:
+    """``confirm_after``: percepts needed to confirm; ``missed_frames_to_missing``: consecutive
+    frames an anchor must be expected yet unseen to be marked missing (more than one rides out
+    a detector's flicker); ``forget_after`` / ``forget_tentative_after``: seconds missing before a
+    confirmed / never-confirmed anchor is forgotten."""
+
+    confirm_after: int = 3
+    missed_frames_to_missing: int = 3
+    forget_after: float = 60.0
+    forget_tentative_after: float = 2.0
+
+    def __post_init__(self) -> None:
+        if self.confirm_after < 1:
+            raise ConfigurationError(f"lifecycle confirm_after must be at least 1 percept, got {self.confirm_after}.")
+        if self.missed_frames_to_missing < 1:
+            raise ConfigurationError(
+                f"lifecycle missed_frames_to_missing must be at least 1, got {self.missed_frames_to_missing}."
+            )
+        for name in ("forget_after", "forget_tentative_after"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ConfigurationError(f"lifecycle {name} must be a non-negative number of seconds, got {value}.")
+
+
+def was_confirmed(anchor: Anchor, config: LifecycleConfig) -> bool:
+    """Whether the anchor has ever been seen often enough to be trusted."""
+    return anchor.times_seen >= config.confirm_after
+
+
+def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
+    """Update the state after an acquire or reacquire; True when the anchor became CONFIRMED."""
+    if was_confirmed(anchor, config):
+        became_confirmed = anchor.state is AnchorState.TENTATIVE
+        anchor.state = AnchorState.CONFIRMED
+        return became_confirmed
+    anchor.state = AnchorState.TENTATIVE
+    return False
+
+
+def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleConfig) -> bool:
+    """Count one frame in which the anchor should have been seen; True when it became MISSING."""
+    if anchor.state is AnchorState.MISSING:
+        return False
+    anchor.missed_frames += 1
+    if anchor.missed_frames < config.missed_frames_to_missing:
+        return False
+    anchor.state = AnchorState.MISSING
+    anchor.missing_since = stamp
+    return True
+
+
+def expire(anchor: Anchor, stamp: float, config: LifecycleConfig) -> bool:
+    """Forget a missing anchor once it has been missing too long; True when it became FORGOTTEN.
+
+    An anchor with an active expectation is not expired: an action has said where it is, and
+    only the camera (a retraction) may overrule that.
+    """
+    if anchor.state is not AnchorState.MISSING or anchor.missing_since is None or anchor.expectation is not None:
+        return False
+    limit = config.forget_after if was_confirmed(anchor, config) else config.forget_tentative_after
+    if stamp - anchor.missing_since < limit:
+        return False
+    anchor.state = AnchorState.FORGOTTEN
+    return True

@@ -1,0 +1,206 @@
+"""The matching table, percepts x anchors, built in one batched pass.
+
+The original SAILOR called its network once per (percept, anchor) pair, each call running the
+backbone on both crops: cost grew with every anchor ever seen, near or far. Here:
+
+1. **gating before scoring**: a k-d tree over anchor positions (:class:`~.anchor_index.AnchorIndex`)
+   returns only anchors within reach of each percept. Reach is
+   ``min(base_gate + maximum_speed * time_since_last_seen, maximum_gate)``: an object cannot
+   have travelled farther than that since it was last seen. A class mismatch is gated too, when
+   configured. Gated pairs are never scored; they hold ``gated_score`` (a penalty below any
+   threshold), so the assignment can never pick them;
+2. **each crop embedded at most once**: only percepts that still have a pair to score and no
+   embedding are embedded, all in one call; the embedding is cached on the returned percept,
+   and anchors keep galleries of past embeddings, never re-embedded;
+3. **tracker continuity, decided by one rule**: a percept whose (non-empty) tracker id continues
+   exactly one CONFIRMED anchor of the same class, last seen at most ``continuation_maximum_age``
+   ago and not gated, is taken as that anchor's continuation: its other pairs are not scored
+   (which is what spares its crop from the backbone) and the pair scores
+   ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
+   floor; a class mismatch never is;
+4. **one vectorised feature computation and one matcher call** for all remaining pairs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
+from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.errors import ConfigurationError
+
+
+class Embedder(Protocol):
+    """Anything that embeds crops, like :class:`merlin2_sailor.perception.embedding.CropEmbedder`."""
+
+    def embed(self, crops: Sequence[np.ndarray]) -> np.ndarray: ...
+
+
+@dataclass(frozen=True, slots=True)
+class MatchingTableConfig:
+    """``base_gate`` (m): reach of an anchor seen just now (depth noise plus a nudge);
+    ``maximum_speed`` (m/s): how fast an unseen object may plausibly have been moved;
+    ``maximum_gate`` (m): the reach's cap, so that long-unseen anchors do not become candidates
+    for every percept in the house (beyond 5 m the distance feature exp(-d) is below 0.007: it
+    says "elsewhere" either way, and a pair there could only match on appearance, which objects
+    of one class often share); ``gate_class_mismatch``: never pair different classes;
+    ``tracker_continuity_score``: the floor for a pair continuing a tracker id;
+    ``continuation_maximum_age`` (s): how recent a continued anchor must be to skip scoring
+    (about a tracker's buffer); ``gated_score``: the penalty gated pairs hold (negative)."""
+
+    base_gate: float = 3.0
+    maximum_speed: float = 0.25
+    maximum_gate: float = 5.0
+    gate_class_mismatch: bool = True
+    tracker_continuity_score: float = 0.9
+    continuation_maximum_age: float = 1.0
+    gated_score: float = -1.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.base_gate) and self.base_gate > 0.0):
+            raise ConfigurationError(f"table base_gate must be a positive number of metres, got {self.base_gate}.")
+        if not (math.isfinite(self.maximum_speed) and self.maximum_speed >= 0.0):
+            raise ConfigurationError(f"table maximum_speed must be >= 0 m/s, got {self.maximum_speed}.")
+        if not (math.isfinite(self.maximum_gate) and self.maximum_gate >= self.base_gate):
+            raise ConfigurationError(
+                f"table maximum_gate ({self.maximum_gate}) must be finite and at least base_gate ({self.base_gate})."
+            )
+        if not (0.0 < self.tracker_continuity_score <= 1.0):
+            raise ConfigurationError(
+                f"table tracker_continuity_score must be in (0, 1], got {self.tracker_continuity_score}."
+            )
+        if not (math.isfinite(self.continuation_maximum_age) and self.continuation_maximum_age >= 0.0):
+            raise ConfigurationError(
+                f"table continuation_maximum_age must be >= 0 seconds, got {self.continuation_maximum_age}."
+            )
+        if not self.gated_score < 0.0:
+            raise ConfigurationError(f"table gated_score must be negative (below any score), got {self.gated_score}.")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class MatchingTable:
+    """Scores of every percept against the anchors that pass the gate for at least one percept.
+
+    ``percepts`` are the inputs with any embedding computed here cached on them; ``anchors`` are
+    the columns (an anchor gated for every percept is not a column at all); ``scores`` hold
+    ``gated_score`` where ``gated``; ``continuations`` marks pairs raised by tracker continuity,
+    ``shortcut`` the percepts taken as continuations without scoring; ``embedded`` counts the crops
+    embedded while building the table.
+    """
+
+    percepts: tuple[Percept, ...]
+    anchors: tuple[Anchor, ...]
+    scores: np.ndarray
+    gated: np.ndarray
+    continuations: np.ndarray
+    shortcut: np.ndarray
+    embedded: int = 0
+
+
+class MatchingTableBuilder:
+    """Builds :class:`MatchingTable` s with one matcher, one configuration, one optional embedder."""
+
+    def __init__(
+        self, matcher: Matcher, config: MatchingTableConfig | None = None, embedder: Embedder | None = None
+    ) -> None:
+        self.matcher = matcher
+        self.config = config or MatchingTableConfig()
+        self.embedder = embedder
+
+    def gate_radius(self, elapsed: np.ndarray | float) -> np.ndarray:
+        """How far an anchor unseen for ``elapsed`` seconds may be from a percept of it."""
+        elapsed = np.maximum(np.asarray(elapsed, dtype=np.float64), 0.0)
+        return np.minimum(self.config.base_gate + self.config.maximum_speed * elapsed, self.config.maximum_gate)
+
+    def build(self, percepts: Sequence[Percept], index: AnchorIndex) -> MatchingTable:
+        percepts = tuple(percepts)
+        columns = PerceptColumns.from_percepts(percepts)
+        pair_rows, pair_slots = self._ungated_pairs(columns, index)
+        if pair_slots.size == 0:
+            return self._empty(percepts)
+        slots, pair_columns = np.unique(pair_slots, return_inverse=True)
+        anchors = tuple(index.anchors_at(slots))
+        anchor_columns = AnchorColumns.from_anchors(anchors)
+        shape = (len(percepts), len(anchors))
+        gated = np.ones(shape, dtype=bool)
+        gated[pair_rows, pair_columns] = False
+
+        same_class = columns.class_names[:, np.newaxis] == anchor_columns.class_names[np.newaxis, :]
+        continuations = tracker_continuations(columns.tracker_ids, anchor_columns.tracker_ids) & same_class & ~gated
+        confirmed = np.array([anchor.state is AnchorState.CONFIRMED for anchor in anchors], dtype=bool)
+        age = columns.stamps[:, np.newaxis] - anchor_columns.last_seen[np.newaxis, :]
+        eligible = continuations & confirmed[np.newaxis, :] & (age <= self.config.continuation_maximum_age)
+        shortcut = eligible.sum(axis=1) == 1
+        gated[shortcut] = ~eligible[shortcut]
+        continuations &= ~gated
+
+        to_score = ~gated & ~shortcut[:, np.newaxis]
+        percepts, embedded = self._embed_needed(percepts, np.flatnonzero(to_score.any(axis=1)))
+        if embedded:
+            columns = PerceptColumns.from_percepts(percepts)
+
+        scores = np.full(shape, self.config.gated_score)
+        rows, score_columns = np.nonzero(to_score)
+        if rows.size:
+            features = pair_features(
+                columns, anchor_columns, rows, score_columns, self.matcher.feature_config, self.matcher.uses_appearance
+            )
+            scores[rows, score_columns] = self.matcher.score_pairs(features)
+        scores[shortcut] = np.where(eligible[shortcut], self.config.tracker_continuity_score, self.config.gated_score)
+        scores = apply_tracker_continuity(scores, continuations, same_class, self.config.tracker_continuity_score)
+        return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded)
+
+    def _ungated_pairs(self, percepts: PerceptColumns, index: AnchorIndex) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, slots) of the pairs that pass the gate, computed on the index's arrays only.
+
+        The k-d tree is asked for the largest reach any anchor can have now; each candidate is then
+        held to its own reach (and class), so only the anchors that pass become Python objects.
+        """
+        empty = np.zeros(0, dtype=np.intp)
+        if len(percepts.stamps) == 0 or len(index) == 0:
+            return empty, empty
+        radius = float(self.gate_radius(float(percepts.stamps.max()) - index.oldest_last_seen()))
+        per_row = index.within(percepts.positions, radius)
+        rows = np.repeat(np.arange(len(per_row), dtype=np.intp), [len(slots) for slots in per_row])
+        if rows.size == 0:
+            return empty, empty
+        slots = np.concatenate(per_row).astype(np.intp)
+        distance = np.linalg.norm(percepts.positions[rows] - index.positions_of(slots), axis=1)
+        passing = distance <= self.gate_radius(percepts.stamps[rows] - index.last_seen_of(slots))
+        if self.config.gate_class_mismatch:
+            passing &= percepts.class_names[rows] == index.class_names_of(slots)
+        return rows[passing], slots[passing]
+
+    def _embed_needed(self, percepts: tuple[Percept, ...], rows: np.ndarray) -> tuple[tuple[Percept, ...], int]:
+        """Embed, in one call, the crops of the given percepts that have none yet."""
+        if not self.matcher.uses_appearance or self.embedder is None:
+            return percepts, 0
+        needed = [int(row) for row in rows if percepts[row].embedding is None and percepts[row].crop.size > 0]
+        if not needed:
+            return percepts, 0
+        return with_embeddings(percepts, needed, self.embedder), len(needed)
+
+    def _empty(self, percepts: tuple[Percept, ...]) -> MatchingTable:
+        empty = np.zeros((len(percepts), 0))
+        return MatchingTable(
+            percepts, (), empty, empty.astype(bool), empty.astype(bool), np.zeros(len(percepts), dtype=bool)
+        )
+
+
+def with_embeddings(percepts: tuple[Percept, ...], rows: Sequence[int], embedder: Embedder) -> tuple[Percept, ...]:
+    """Return the percepts with the crops at ``rows`` embedded (one batched call) and cached on them."""
+    features = np.asarray(embedder.embed([percepts[row].crop for row in rows]), dtype=np.float32)
+    updated = list(percepts)
+    for row, feature in zip(rows, features, strict=True):
+        updated[row] = dataclasses.replace(percepts[row], embedding=feature)
+    return tuple(updated)

@@ -1,0 +1,107 @@
+"""Anchors to plain data and back, so they survive a node restart.
+
+The node persists a snapshot through the knowledge layer or a file; either way it must be plain,
+JSON-safe data (dicts, lists, strings, numbers). Appearance galleries are the bulk of an anchor,
+so they travel as base64 of their little-endian bfloat16 bits (1280-d: 3.4 kB per view) instead
+of lists of numbers (~25 kB of JSON each).
+"""
+
+from __future__ import annotations
+
+import base64
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.gallery import GALLERY_DTYPE
+from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.knowledge.model import Provenance
+
+#: Identifies a snapshot; restore refuses anything else.
+SNAPSHOT_FORMAT = "merlin2_sailor.anchors"
+#: Bump when the layout of :func:`anchor_to_dict` changes incompatibly.
+SNAPSHOT_VERSION = 1
+
+_GALLERY_BYTE_ORDER = np.dtype(GALLERY_DTYPE).newbyteorder("<")
+
+
+def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
+    gallery = None
+    if anchor.gallery is not None and len(anchor.gallery):
+        gallery = {
+            "shape": list(anchor.gallery.shape),
+            "bfloat16_base64": base64.b64encode(anchor.gallery.astype(_GALLERY_BYTE_ORDER).tobytes()).decode("ascii"),
+        }
+    return {
+        "symbol": anchor.symbol,
+        "class_name": anchor.class_name,
+        "position": anchor.position.tolist(),
+        "size": anchor.size.tolist(),
+        "first_seen": float(anchor.first_seen),
+        "last_seen": float(anchor.last_seen),
+        "state": anchor.state.value,
+        "times_seen": int(anchor.times_seen),
+        "last_tracker_id": anchor.last_tracker_id,
+        "class_votes": {name: float(votes) for name, votes in anchor.class_votes.items()},
+        "position_variance": float(anchor.position_variance),
+        "gallery": gallery,
+        "missed_frames": int(anchor.missed_frames),
+        "missing_since": anchor.missing_since,
+        "provenance": anchor.provenance.value,
+        "perceived_position": anchor.perceived_position.tolist(),
+        "expectation": None if anchor.expectation is None else anchor.expectation.describe(),
+        "expectation_confirmed": bool(anchor.expectation_confirmed),
+    }
+
+
+def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
+    """Rebuild an anchor; it comes back not visible, since nothing has been seen since the restart."""
+    try:
+        anchor = Anchor(
+            symbol=str(data["symbol"]),
+            class_name=str(data["class_name"]),
+            position=_vector(data["position"], "position"),
+            size=_vector(data["size"], "size"),
+            first_seen=float(data["first_seen"]),
+            last_seen=float(data["last_seen"]),
+            state=AnchorState(data["state"]),
+            times_seen=int(data["times_seen"]),
+            last_tracker_id=str(data.get("last_tracker_id", "")),
+            class_votes={str(k): float(v) for k, v in dict(data.get("class_votes") or {}).items()},
+            position_variance=float(data["position_variance"]),
+            gallery=_gallery(data.get("gallery")),
+            visible=False,
+            missed_frames=int(data.get("missed_frames", 0)),
+            missing_since=None if data.get("missing_since") is None else float(data["missing_since"]),
+            provenance=Provenance(data.get("provenance", Provenance.PERCEIVED.value)),
+            perceived_position=_vector(data.get("perceived_position", data["position"]), "perceived_position"),
+            expectation=None if data.get("expectation") is None else Expectation.from_description(data["expectation"]),
+            expectation_confirmed=bool(data.get("expectation_confirmed", False)),
+        )
+    except (KeyError, ValueError, TypeError) as error:
+        name = data.get("symbol", "?") if isinstance(data, Mapping) else "?"
+        raise InvalidInputError(f"Cannot restore anchor {name!r} from its snapshot: {error!r}.") from error
+    if not anchor.class_votes:
+        anchor.class_votes = {anchor.class_name: 1.0}
+    return anchor
+
+
+def _vector(values: Any, name: str) -> np.ndarray:
+    vector = np.asarray(values, dtype=np.float64).reshape(-1)
+    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
+        raise ValueError(f"{name} must be 3 finite numbers, got {values!r}")
+    return vector
+
+
+def _gallery(data: Mapping[str, Any] | None) -> np.ndarray | None:
+    if data is None:
+        return None
+    shape = tuple(int(n) for n in data["shape"])
+    raw = base64.b64decode(data["bfloat16_base64"], validate=True)
+    gallery = np.frombuffer(raw, dtype=_GALLERY_BYTE_ORDER)
+    if len(shape) != 2 or gallery.size != shape[0] * shape[1]:
+        raise ValueError(f"gallery bytes do not fill the shape {shape}")
+    return gallery.reshape(shape).astype(GALLERY_DTYPE)

@@ -1,0 +1,330 @@
+"""anchoring: SAILOR's anchoring layer as a node: percepts in, anchors, events and facts out.
+
+For every PerceptArray it runs acquire / reacquire (the matching table, then Hungarian) in the
+ROS-free :class:`~merlin2_sailor.anchoring.Anchoring`, with the camera's pose, intrinsics and depth
+at the percepts' stamp, so anchors that should have been visible but were not become missing.
+A timer runs Track (expected effects, carried objects, forgetting). Off the hot path, a worker
+thread syncs the anchors into the knowledge base by diff and saves them to disk, so they survive
+a restart with the same symbols.
+
+Topics: in ``percepts``, ``color/camera_info``, ``camera_pose``, ``depth/image_raw`` (optional,
+for occlusion), ``robot_pose`` (for carried objects); out ``anchors`` (latched, on change),
+``anchor_events``, ``anchor_markers``. Services (private): ``~/get_anchors``, ``~/find_anchor``,
+``~/forget_anchor``, ``~/expect_anchor``.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
+from rclpy.node import Node
+from sensor_msgs.msg import CameraInfo, Image
+from std_msgs.msg import Header
+from visualization_msgs.msg import MarkerArray
+
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_view import views_of
+from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig, AnchoringResult
+from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, PersistenceWorker
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+from merlin2_sailor.anchoring.state_file import AnchoringStateFile
+from merlin2_sailor.anchoring.symbols import SymbolCounter
+from merlin2_sailor.anchoring.visibility import CameraView
+from merlin2_sailor.errors import ConfigurationError, SailorError
+from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
+from merlin2_sailor.knowledge.store import KnowledgeBase
+from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
+from merlin2_sailor.perception.camera_model import CameraIntrinsics
+from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.perception.stamped_buffer import StampedBuffer
+from merlin2_sailor.resources import config_file
+from merlin2_sailor.ros.conversions import (
+    camera_info_to_intrinsics,
+    depth_to_metres,
+    image_to_array,
+    percepts_from_message,
+    pose_from_message,
+    stamp_to_seconds,
+)
+from merlin2_sailor.ros.conversions.anchoring import anchor_markers, anchors_to_message, events_to_message
+from merlin2_sailor.ros.node_runner import run_node
+from merlin2_sailor.ros.parameters import declare_parameter
+from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
+
+NODE_NAME = "anchoring"
+
+
+class AnchoringNode(Node):
+    def __init__(self, **node_options: Any) -> None:
+        super().__init__(NODE_NAME, **node_options)
+        world_frame = declare_parameter(self, "world_frame", "map", "Fixed frame the anchors live in.")
+        matcher = declare_parameter(
+            self, "matcher", "rules",
+            "Matching function: 'rules' (class, distance, time) or 'network' (the learned one).")
+        weights = declare_parameter(self, "weights", "", "Matching network weights file (matcher 'network').")
+        backbone = declare_parameter(
+            self, "backbone", "efficientnet_lite0", "Crop backbone the network was trained with.")
+        knowledge_base = declare_parameter(
+            self, "knowledge_base", "ros:///merlin2",
+            "Knowledge base the anchors are synced into ('' for none): ros:///namespace, "
+            "sqlite:///path, mongodb://host/db or memory.")
+        grounding_file = declare_parameter(
+            self, "grounding", "", "Grounding YAML (class -> type, map); empty: config/grounding.yaml.")
+        state_folder = declare_parameter(
+            self, "state_folder", "~/.sailor/anchoring",
+            "Folder where anchors and symbol counters are saved ('' to start afresh every time).")
+        sync_period = declare_parameter(
+            self, "sync_period", 0.5, "Seconds between knowledge-base syncs.", minimum=0.05, maximum=60.0)
+        save_period = declare_parameter(
+            self, "save_period", 2.0, "Seconds between saves of the anchors.", minimum=0.1, maximum=3600.0)
+        track_period = declare_parameter(
+            self, "track_period", 0.5, "Seconds between Track steps.", minimum=0.05, maximum=60.0)
+        stamp_tolerance = declare_parameter(
+            self, "stamp_tolerance", 0.05,
+            "Largest gap (s) between percepts and the camera pose / depth they are judged with.",
+            minimum=0.0, maximum=1.0)
+
+        self._lock = threading.Lock()  # the core is single-threaded; the worker reads under this
+        self._state_file = AnchoringStateFile(state_folder) if state_folder else None
+        saved = self._state_file.load() if self._state_file else None
+        self._symbols = SymbolCounter(saved.symbol_indices if saved else None)
+        if saved and saved.owned_objects:
+            self._symbols.note_used(saved.owned_objects)  # symbols the knowledge base has seen
+        self._anchoring = Anchoring(
+            AnchoringConfig(world_frame=world_frame),
+            matcher=self._make_matcher(matcher, weights, backbone),
+            symbol_factory=self._new_symbol,
+        )
+        if saved and saved.snapshot:
+            self._anchoring.restore(saved.snapshot)
+            self.get_logger().info(f"restored {len(self._anchoring)} anchors from {state_folder}")
+        self._world_frame = world_frame
+        self._intrinsics: CameraIntrinsics | None = None
+        self._poses: StampedBuffer[Pose] = StampedBuffer(tolerance=stamp_tolerance)
+        self._depths: StampedBuffer[np.ndarray] = StampedBuffer(capacity=5, tolerance=stamp_tolerance)
+        self._robot_pose: Pose | None = None
+
+        self._anchors_publisher = self.create_publisher(AnchorArray, "anchors", LATCHED)
+        self._events_publisher = self.create_publisher(AnchorEventArray, "anchor_events", EVENTS)
+        self._markers_publisher = self.create_publisher(MarkerArray, "anchor_markers", LATCHED)
+        self.create_subscription(PerceptArray, "percepts", self._on_percepts, SENSOR_DATA)
+        self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, SENSOR_DATA)
+        self.create_subscription(PoseStamped, "camera_pose", self._on_camera_pose, SENSOR_DATA)
+        self.create_subscription(Image, "depth/image_raw", self._on_depth, SENSOR_DATA)
+        self.create_subscription(PoseStamped, "robot_pose", self._on_robot_pose, SENSOR_DATA)
+        self.create_service(srv.GetAnchors, "~/get_anchors", self._get_anchors)
+        self.create_service(srv.FindAnchor, "~/find_anchor", self._find_anchor)
+        self.create_service(srv.ForgetAnchor, "~/forget_anchor", self._forget_anchor)
+        self.create_service(srv.ExpectAnchor, "~/expect_anchor", self._expect_anchor)
+        self.create_timer(track_period, self._track)
+
+        self._worker = PersistenceWorker(
+            self._copy_anchors, self._state_file, self._knowledge_base_opener(knowledge_base),
+            Grounding(GroundingConfig.from_yaml(grounding_file or config_file("grounding.yaml"))),
+            owned_objects=saved.owned_objects if saved else frozenset(),
+            sync_period=sync_period, save_period=save_period, log=self._log,
+        )
+        self._worker.start()
+        self._publish_state()
+        self.get_logger().info(
+            f"anchoring in '{world_frame}' with the {matcher} matcher; "
+            f"knowledge base: {knowledge_base or 'none'}")
+
+    def destroy_node(self) -> None:
+        self._worker.stop()
+        super().destroy_node()
+
+    # Construction helpers.
+
+    def _make_matcher(self, name: str, weights: str, backbone: str) -> Any:
+        if name == "rules":
+            return RuleMatcher()
+        if name == "network":
+            if not weights:
+                raise ConfigurationError("matcher 'network' needs the 'weights' parameter (a weights file)")
+            from merlin2_sailor.anchoring.matching_network import NetworkMatcher
+
+            return NetworkMatcher.from_file(weights, backbone)
+        raise ConfigurationError(f"unknown matcher '{name}'; use 'rules' or 'network'")
+
+    def _knowledge_base_opener(self, location: str) -> Any:
+        if not location:
+            return None
+        if location.startswith(ROS_PREFIX):
+            from merlin2_sailor.ros.knowledge_base_client import RemoteKnowledgeBase
+
+            namespace = location.removeprefix(ROS_PREFIX) or "/"
+            return lambda: RemoteKnowledgeBase(namespace=namespace, timeout=2.0)
+        return lambda: open_store(location)
+
+    def _new_symbol(self, class_name: str) -> str:
+        symbol = self._symbols(class_name)
+        if self._state_file is not None:  # before the symbol can reach anyone
+            self._state_file.save_symbols(self._symbols.last_indices)
+        return symbol
+
+    def _log(self, level: str, message: str) -> None:
+        getattr(self.get_logger(), level)(message)
+
+    # Inputs.
+
+    def _on_camera_info(self, message: CameraInfo) -> None:
+        try:
+            self._intrinsics = camera_info_to_intrinsics(message)
+        except SailorError as error:
+            self.get_logger().warning(f"dropped camera info: {error}", throttle_duration_sec=5.0)
+
+    def _on_camera_pose(self, message: PoseStamped) -> None:
+        try:
+            self._poses.add(stamp_to_seconds(message.header.stamp), pose_from_message(message.pose))
+        except SailorError as error:
+            self.get_logger().warning(f"dropped camera pose: {error}", throttle_duration_sec=5.0)
+
+    def _on_robot_pose(self, message: PoseStamped) -> None:
+        try:
+            self._robot_pose = pose_from_message(message.pose)
+        except SailorError as error:
+            self.get_logger().warning(f"dropped robot pose: {error}", throttle_duration_sec=5.0)
+
+    def _on_depth(self, message: Image) -> None:
+        try:
+            depth = depth_to_metres(image_to_array(message), message.encoding)
+        except SailorError as error:
+            self.get_logger().warning(f"dropped depth image: {error}", throttle_duration_sec=5.0)
+            return
+        self._depths.add(stamp_to_seconds(message.header.stamp), depth)
+
+    def _on_percepts(self, message: PerceptArray) -> None:
+        stamp = stamp_to_seconds(message.header.stamp)
+        try:
+            percepts = percepts_from_message(message)
+            with self._lock:
+                result = self._anchoring.process(percepts, self._camera_view(stamp), stamp)
+        except SailorError as error:
+            self.get_logger().warning(f"dropped {len(message.percepts)} percepts: {error}",
+                                      throttle_duration_sec=5.0)
+            return
+        self._publish(result)
+
+    def _camera_view(self, stamp: float) -> CameraView | None:
+        """The camera as it was at ``stamp``; without it no anchor is judged missing."""
+        pose = self._poses.nearest(stamp)
+        if self._intrinsics is None or pose is None:
+            return None
+        depth = self._depths.nearest(stamp)
+        if depth is not None and depth.shape != (self._intrinsics.height, self._intrinsics.width):
+            depth = None
+        return CameraView(self._intrinsics, pose, depth)
+
+    def _track(self) -> None:
+        now = self.get_clock().now().nanoseconds * 1e-9
+        with self._lock:
+            result = self._anchoring.track(now, self._robot_pose)
+        self._publish(result)
+
+    # Outputs.
+
+    def _copy_anchors(self) -> AnchorsCopy:
+        with self._lock:
+            views = views_of(self._anchoring.anchors)
+
+        def snapshot() -> dict[str, Any]:
+            with self._lock:
+                return self._anchoring.snapshot()
+
+        return AnchorsCopy(views, snapshot)
+
+    def _publish(self, result: AnchoringResult) -> None:
+        if not result.events:
+            return
+        with self._lock:
+            class_names = {anchor.symbol: anchor.class_name for anchor in self._anchoring.anchors}
+        class_names.update({anchor.symbol: anchor.class_name for anchor in result.forgotten})
+        header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
+        self._events_publisher.publish(events_to_message(result.events, class_names, header))
+        self._publish_state()
+
+    def _publish_state(self) -> None:
+        with self._lock:
+            anchors = sorted(self._anchoring.anchors, key=lambda anchor: anchor.symbol)
+        header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
+        self._anchors_publisher.publish(anchors_to_message(anchors, header))
+        self._markers_publisher.publish(anchor_markers(anchors, header))
+
+    # Services.
+
+    def _get_anchors(self, request: srv.GetAnchors.Request, response: srv.GetAnchors.Response) -> Any:
+        with self._lock:
+            anchors = [a for a in self._anchoring.anchors
+                       if (not request.symbol or a.symbol == request.symbol)
+                       and (not request.class_name or a.class_name == request.class_name)]
+        response.anchors = anchors_to_message(sorted(anchors, key=lambda a: a.symbol), Header()).anchors
+        response.frame_id = self._world_frame
+        return response
+
+    def _find_anchor(self, request: srv.FindAnchor.Request, response: srv.FindAnchor.Response) -> Any:
+        if not request.symbol and not request.class_name:
+            response.message = "give a symbol or a class name"
+            return response
+        near = (np.array([request.point.x, request.point.y, request.point.z])
+                if request.use_point else None)
+        with self._lock:
+            found: Anchor | None = self._anchoring.find(
+                symbol=request.symbol or None, class_name=request.class_name or None, near=near)
+            if found is not None:
+                response.anchor = anchors_to_message([found], Header()).anchors[0]
+        response.found = found is not None
+        if found is None:
+            response.message = f"no anchor for {request.symbol or request.class_name!r}"
+        return response
+
+    def _forget_anchor(self, request: srv.ForgetAnchor.Request, response: srv.ForgetAnchor.Response) -> Any:
+        now = self.get_clock().now().nanoseconds * 1e-9
+        try:
+            with self._lock:
+                event = self._anchoring.forget(request.symbol, now)
+        except SailorError as error:
+            response.message = str(error)
+            return response
+        self._publish(AnchoringResult(stamp=now, events=(event,)))
+        response.success = True
+        return response
+
+    def _expect_anchor(self, request: srv.ExpectAnchor.Request, response: srv.ExpectAnchor.Response) -> Any:
+        now = self.get_clock().now().nanoseconds * 1e-9
+        position = np.array([request.position.x, request.position.y, request.position.z])
+        try:
+            with self._lock:
+                if request.symbol not in self._anchoring:
+                    raise ConfigurationError(f"no anchor '{request.symbol}'")
+                if request.expectation == request.EXPECT_AT:
+                    self._anchoring.expect(request.symbol, Expectation.at(
+                        position, now, place=request.place, source=request.source))
+                elif request.expectation == request.EXPECT_CARRIED:
+                    self._anchoring.expect(request.symbol, Expectation.carried(
+                        now, offset=position, source=request.source), robot_pose=self._robot_pose)
+                elif request.expectation == request.CLEAR:
+                    self._anchoring.clear_expectation(request.symbol)
+                else:
+                    raise ConfigurationError(f"unknown expectation {request.expectation}")
+        except SailorError as error:
+            response.message = str(error)
+            return response
+        response.success = True
+        self._publish_state()
+        return response
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return run_node(AnchoringNode, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

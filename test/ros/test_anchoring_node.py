@@ -1,0 +1,150 @@
+"""The anchoring node over DDS: percepts in; anchors, events, services and knowledge-base facts out;
+and anchors that survive a SIGKILL with their symbols.
+
+The test plays the perceptual layer: it publishes the camera's intrinsics and pose and, with the
+same stamps, PerceptArrays of a cup and a book in front of the camera. The world has a z-up map
+frame; the camera is 1 m above the origin looking along +x (as rgbd_player's default pose).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import numpy as np
+import pytest
+from geometry_msgs.msg import PoseStamped
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import Anchor, AnchorArray, AnchorEvent, AnchorEventArray, PerceptArray
+from rclpy.qos import QoSProfile
+from sensor_msgs.msg import CameraInfo
+from std_msgs.msg import Header
+
+from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.knowledge import open_store
+from merlin2_sailor.ros.conversions import camera_info_message, percepts_to_message, seconds_to_stamp
+from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
+from merlin2_sailor_demos.rgbd_player_node import DEFAULT_CAMERA_POSE
+
+pytestmark = pytest.mark.ros
+
+CUP = ("cup", np.array([3.5, 0.5, 0.8]))  # 0.7 m from the kitchen waypoint of config/grounding.yaml
+BOOK = ("book", np.array([2.5, 1.0, 0.8]))  # in view, left of the cup
+SAILOR = str(Path(sys.executable).parent / "sailor")
+
+
+class PerceptionStandIn:
+    """Publishes what the perceptual layer would, through the test's probe node."""
+
+    def __init__(self, probe) -> None:
+        node = probe.node
+        self._clock = node.get_clock()
+        self._info = node.create_publisher(CameraInfo, "/color/camera_info", SENSOR_DATA)
+        self._pose = node.create_publisher(PoseStamped, "/camera_pose", SENSOR_DATA)
+        self._percepts = node.create_publisher(PerceptArray, "/percepts", SENSOR_DATA)
+
+    def frame(self, objects) -> None:
+        stamp = self._clock.now().nanoseconds * 1e-9
+        header = Header(stamp=seconds_to_stamp(stamp), frame_id="camera_color_optical_frame")
+        self._info.publish(camera_info_message(640, 480, 500.0, 500.0, 320.0, 240.0, header))
+        pose = PoseStamped(header=Header(stamp=header.stamp, frame_id="map"))
+        p, o = pose.pose.position, pose.pose.orientation
+        p.x, p.y, p.z, o.x, o.y, o.z, o.w = DEFAULT_CAMERA_POSE
+        self._pose.publish(pose)
+        time.sleep(0.02)  # the pose is there before the percepts, as in the real pipeline
+        percepts = [Percept(class_name=name, score=0.9, box=BoundingBox2D(320, 240, 40, 40),
+                            position=position, size=np.array([0.1, 0.1, 0.12]), stamp=stamp,
+                            crop=np.zeros((8, 8, 3), np.uint8), frame_id="map")
+                    for name, position in objects]
+        self._percepts.publish(percepts_to_message(percepts, Header(stamp=header.stamp, frame_id="map")))
+        time.sleep(0.1)
+
+
+def start_anchoring(node_process, state_folder, knowledge_namespace):
+    return node_process(
+        "anchoring", "--ros-args", "-p", f"state_folder:={state_folder}",
+        "-p", f"knowledge_base:=ros://{knowledge_namespace}", "-p", "sync_period:=0.2",
+        "-p", "save_period:=0.2")
+
+
+def call(probe, service_type, name, request, timeout=15.0):
+    client = probe.node.create_client(service_type, name)
+    try:
+        assert client.wait_for_service(timeout_sec=timeout), f"{name} did not appear"
+        future = client.call_async(request)
+        assert probe.wait_for(future.done, timeout), f"{name} did not answer"
+        return future.result()
+    finally:
+        probe.node.destroy_client(client)
+
+
+def latest_anchors(probe) -> dict[str, Anchor]:
+    (array,) = probe.collect(AnchorArray, "/anchors", 1, LATCHED)
+    return {anchor.symbol: anchor for anchor in array.anchors}
+
+
+def test_anchoring_over_dds_with_the_knowledge_base_and_a_restart(tmp_path, ros_probe, node_process) -> None:
+    namespace = f"/kb_{uuid.uuid4().hex[:8]}"
+    knowledge_base = node_process("knowledge_base", "--ros-args", "-r", f"__ns:={namespace}")
+    anchoring = start_anchoring(node_process, tmp_path / "state", namespace)
+    assert ros_probe.wait_for_node("/anchoring"), anchoring.text
+    events: list = []
+    ros_probe.node.create_subscription(AnchorEventArray, "/anchor_events", events.append,
+                                       QoSProfile(depth=100, reliability=EVENTS.reliability))
+    camera = PerceptionStandIn(ros_probe)
+    time.sleep(1.0)  # discovery between the stand-in's publishers and the node
+
+    for _ in range(4):  # both seen: acquired, then confirmed after three sightings
+        camera.frame([CUP, BOOK])
+    anchors = latest_anchors(ros_probe)
+    assert sorted(anchors) == ["book_1", "cup_1"], anchoring.text
+    assert anchors["cup_1"].state == Anchor.STATE_CONFIRMED
+    np.testing.assert_allclose([anchors["cup_1"].position.x, anchors["cup_1"].position.y], [3.5, 0.5], atol=0.05)
+
+    for _ in range(4):  # the book is in view but no longer seen: it goes missing
+        camera.frame([CUP])
+    anchors = latest_anchors(ros_probe)
+    assert anchors["book_1"].state == Anchor.STATE_MISSING
+    assert anchors["cup_1"].state == Anchor.STATE_CONFIRMED
+    kinds = [(event.kind, event.symbol) for batch in events for event in batch.events]
+    assert (AnchorEvent.KIND_ACQUIRED, "cup_1") in kinds and (AnchorEvent.KIND_MISSING, "book_1") in kinds
+
+    found = call(ros_probe, srv.FindAnchor, "/anchoring/find_anchor", srv.FindAnchor.Request(class_name="cup"))
+    assert found.found and found.anchor.symbol == "cup_1"
+    nothing = call(ros_probe, srv.FindAnchor, "/anchoring/find_anchor", srv.FindAnchor.Request(class_name="dog"))
+    assert not nothing.found and "dog" in nothing.message
+
+    table = subprocess.run([SAILOR, "anchors"], capture_output=True, text=True, timeout=60)
+    assert table.returncode == 0, table.stderr
+    assert "cup_1" in table.stdout and "confirmed" in table.stdout and "missing" in table.stdout
+
+    with open_store(f"ros://{namespace}") as store:  # the sync wrote the anchors as facts
+        assert ros_probe.wait_for(lambda: store.objects.get("cup_1") is not None, timeout=10.0)
+        facts = {(fact.predicate, fact.objects) for fact in store.propositions_about("cup_1")}
+        assert ("object_at", ("cup_1", "kitchen")) in facts and ("seen", ("cup_1",)) in facts
+
+        time.sleep(0.6)  # a save period or two: the state file holds both anchors
+        anchoring.process.kill()  # SIGKILL: no chance to save anything more
+        anchoring.stop()
+        # The dead node stays in the graph until its participant lease (3 s) expires.
+        assert ros_probe.wait_for(lambda: "/anchoring" not in ros_probe.node_names(), timeout=15.0)
+        anchoring = start_anchoring(node_process, tmp_path / "state", namespace)
+        assert ros_probe.wait_for_node("/anchoring"), anchoring.text
+        restored = call(ros_probe, srv.GetAnchors, "/anchoring/get_anchors", srv.GetAnchors.Request())
+        assert sorted(anchor.symbol for anchor in restored.anchors) == ["book_1", "cup_1"], anchoring.text
+
+        forgotten = call(ros_probe, srv.ForgetAnchor, "/anchoring/forget_anchor",
+                         srv.ForgetAnchor.Request(symbol="book_1"))
+        assert forgotten.success
+        time.sleep(0.5)
+        camera.frame([CUP, ("cup", np.array([2.2, -1.0, 0.8]))])  # a second cup, far from the first
+        anchors = latest_anchors(ros_probe)
+        assert sorted(anchors) == ["cup_1", "cup_2"]  # the old cup kept its symbol; no reuse
+        assert ros_probe.wait_for(lambda: store.objects.get("book_1") is None, timeout=10.0)
+        cups = [obj.name for obj in store.objects.get_all() if obj.name.startswith("cup")]
+        assert cups.count("cup_1") == 1
+    assert anchoring.stop() == 0, anchoring.text
+    assert knowledge_base.stop() == 0, knowledge_base.text

@@ -1,0 +1,301 @@
+"""Anchoring.process: the paper's acquire / reacquire algorithm and the anchor lifecycle."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import (
+    AnchorEventKind,
+    Anchoring,
+    AnchoringConfig,
+    AnchorState,
+    LifecycleConfig,
+    MatchingTableConfig,
+)
+from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
+
+from .anchoring_scenes import KITCHEN, TWIN_MUGS, SceneObject, camera_view, flat_depth, with_occluder
+
+FRAME = 1.0 / 15.0  # seconds between frames
+
+
+def kinds(result, symbol=None):
+    return [event.kind for event in result.events if symbol is None or event.symbol == symbol]
+
+
+def test_no_anchors_acquires_every_percept(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    percepts = [maker.percept(item, 0.0) for item in KITCHEN]
+    result = anchoring.process(percepts, camera_view(), 0.0)
+    assert [a.class_name for a in result.acquired] == ["cup", "bowl", "apple"]
+    assert result.percept_symbols == ("cup_1", "bowl_1", "apple_1")
+    assert kinds(result) == [AnchorEventKind.ACQUIRED] * 3
+    assert all(anchor.state is AnchorState.TENTATIVE and anchor.visible for anchor in result.acquired)
+    assert len(anchoring) == 3
+
+
+def test_same_objects_again_are_reacquired_and_confirmed(make_anchoring, maker):
+    anchoring = make_anchoring()
+    first = anchoring.process([maker.percept(item, 0.0) for item in KITCHEN], camera_view(), 0.0)
+    second = anchoring.process([maker.percept(item, FRAME) for item in reversed(KITCHEN)], camera_view(), FRAME)
+    assert second.acquired == ()
+    assert second.percept_symbols == tuple(reversed(first.percept_symbols))
+    assert {a.symbol for a in second.reacquired} == set(first.percept_symbols)
+    # quick lifecycle: confirmed after two sightings, one CONFIRMED event each
+    assert kinds(second).count(AnchorEventKind.CONFIRMED) == 3
+    assert all(a.state is AnchorState.CONFIRMED and a.times_seen == 2 for a in anchoring.anchors)
+
+
+def test_confirm_after_one_confirms_on_acquisition(maker, kitchen):
+    anchoring = Anchoring(AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=1)))
+    result = anchoring.process([maker.percept(kitchen["apple"], 0.0)], None, 0.0)
+    assert kinds(result) == [AnchorEventKind.ACQUIRED, AnchorEventKind.CONFIRMED]
+    assert result.acquired[0].state is AnchorState.CONFIRMED
+
+
+def test_a_percept_matching_no_anchor_acquires_a_new_one(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    anchoring.process([maker.percept(kitchen["red_cup"], 0.0)], None, 0.0)
+    stranger = SceneObject("green_cup", "cup", (2.0, 1.5, 0.8))
+    result = anchoring.process(
+        [maker.percept(kitchen["red_cup"], FRAME), maker.percept(stranger, FRAME)], None, FRAME
+    )
+    assert result.percept_symbols == ("cup_1", "cup_2")
+    assert [a.symbol for a in result.acquired] == ["cup_2"]
+
+
+def test_more_percepts_than_anchors(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    anchoring.process([maker.percept(kitchen["apple"], 0.0)], None, 0.0)
+    result = anchoring.process([maker.percept(item, FRAME) for item in KITCHEN], None, FRAME)
+    assert [a.symbol for a in result.reacquired] == ["apple_1"]
+    assert sorted(a.symbol for a in result.acquired) == ["bowl_1", "cup_1"]
+    assert len(anchoring) == 3
+
+
+def test_two_identical_looking_objects_a_metre_apart_keep_their_identities(make_anchoring, maker, twin_mugs):
+    anchoring = make_anchoring()
+    left, right = twin_mugs["left_mug"], twin_mugs["right_mug"]
+    first = anchoring.process([maker.percept(left, 0.0), maker.percept(right, 0.0)], camera_view(), 0.0)
+    left_symbol, right_symbol = first.percept_symbols
+    assert left_symbol != right_symbol
+    for frame in range(1, 30):
+        stamp = frame * FRAME
+        # order shuffled, and now and then one of the two is not detected
+        seen = [left, right] if frame % 2 else [right, left]
+        if frame % 7 == 0:
+            seen = seen[:1]
+        result = anchoring.process([maker.percept(item, stamp) for item in seen], camera_view(), stamp)
+        expected = [left_symbol if item is left else right_symbol for item in seen]
+        assert list(result.percept_symbols) == expected, f"frame {frame}"
+        assert result.acquired == ()
+    assert len(anchoring) == 2
+    assert np.linalg.norm(anchoring.get(left_symbol).position - left.position) < 0.03
+
+
+def test_object_leaving_and_reentering_view_is_reacquired_with_its_symbol(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    symbol = anchoring.process([maker.percept(cup, 0.0)], camera_view(), 0.0).percept_symbols[0]
+    # the camera turns away (the cup is behind it): not seen, but not expected to be seen either
+    turned_away = camera_view(yaw=math.pi)
+    for frame in range(1, 20):
+        result = anchoring.process([], turned_away, frame * FRAME)
+        assert result.missing == ()
+    assert anchoring.get(symbol).visible is False
+    back = anchoring.process([maker.percept(cup, 20 * FRAME)], camera_view(), 20 * FRAME)
+    assert back.percept_symbols == (symbol,)
+    assert back.acquired == ()
+
+
+def test_occluded_object_is_not_marked_missing(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    anchoring.process([maker.percept(cup, 0.0)], camera_view(), 0.0)
+    view = camera_view()
+    depth = with_occluder(flat_depth(5.0), view, cup.position, distance=1.0)  # a person 1 m away, in front
+    occluded_view = camera_view(depth=depth)
+    for frame in range(1, 10):
+        result = anchoring.process([], occluded_view, frame * FRAME)
+        assert result.missing == () and AnchorEventKind.MISSING not in kinds(result)
+    assert anchoring.get("cup_1").state is not AnchorState.MISSING
+
+
+def test_object_outside_the_frustum_is_not_marked_missing(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    anchoring.process([maker.percept(item, 0.0) for item in KITCHEN], camera_view(), 0.0)
+    # turned 90 degrees left: the kitchen is out of the image
+    for frame in range(1, 10):
+        assert anchoring.process([], camera_view(yaw=math.pi / 2), frame * FRAME).missing == ()
+    # moved far back: in the image but beyond the sensor's range
+    assert anchoring.process([], camera_view(position=(-10.0, 0.0, 1.0)), 1.0).missing == ()
+    assert all(a.state is AnchorState.TENTATIVE for a in anchoring.anchors)
+
+
+def test_depth_at_the_object_itself_does_not_count_as_occlusion(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    anchoring.process([maker.percept(cup, 0.0)], camera_view(), 0.0)
+    # the depth image sees the cup's own front surface (5 cm nearer than its centre): visible, so missing
+    view = camera_view()
+    depth = with_occluder(flat_depth(5.0), view, cup.position, distance=cup.position[0] - 0.05)
+    result = anchoring.process([], camera_view(depth=depth), FRAME)
+    assert [a.symbol for a in result.missing] == ["cup_1"]
+
+
+def test_unknown_depth_at_the_object_proves_nothing(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    anchoring.process([maker.percept(kitchen["red_cup"], 0.0)], camera_view(), 0.0)
+    result = anchoring.process([], camera_view(depth=flat_depth(np.nan)), FRAME)
+    assert result.missing == ()
+
+
+def test_visible_but_absent_object_goes_missing_then_forgotten(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup, bowl = kitchen["red_cup"], kitchen["blue_bowl"]
+    for frame in range(3):
+        stamp = frame * FRAME
+        anchoring.process([maker.percept(cup, stamp), maker.percept(bowl, stamp)], camera_view(), stamp)
+    assert anchoring.get("cup_1").state is AnchorState.CONFIRMED
+    view = camera_view(depth=flat_depth(6.0))  # a wall behind the table: nothing hides the cup
+    missing_at = 1.0
+    result = anchoring.process([maker.percept(bowl, missing_at)], view, missing_at)
+    assert [a.symbol for a in result.missing] == ["cup_1"]
+    assert kinds(result, "cup_1") == [AnchorEventKind.MISSING]
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    # still missing, not yet forgotten (forget_after = 5 s), and no second MISSING event
+    result = anchoring.process([maker.percept(bowl, missing_at + 4.0)], view, missing_at + 4.0)
+    assert result.missing == () and result.forgotten == ()
+    result = anchoring.process([maker.percept(bowl, missing_at + 5.0)], view, missing_at + 5.0)
+    assert [a.symbol for a in result.forgotten] == ["cup_1"]
+    assert result.forgotten[0].state is AnchorState.FORGOTTEN
+    assert kinds(result, "cup_1") == [AnchorEventKind.FORGOTTEN]
+    assert "cup_1" not in anchoring and anchoring.get("bowl_1") is not None
+
+
+def test_missing_needs_the_configured_number_of_missed_frames(maker, kitchen):
+    anchoring = Anchoring(AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=1, missed_frames_to_missing=3)))
+    anchoring.process([maker.percept(kitchen["red_cup"], 0.0)], camera_view(), 0.0)
+    missing = [bool(anchoring.process([], camera_view(), frame * FRAME).missing) for frame in range(1, 5)]
+    assert missing == [False, False, True, False]
+
+
+def test_missing_anchor_is_restored_when_seen_again(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    anchoring.process([maker.percept(cup, 0.0)], camera_view(), 0.0)
+    anchoring.process([maker.percept(cup, FRAME)], camera_view(), FRAME)
+    anchoring.process([], camera_view(), 2 * FRAME)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    result = anchoring.process([maker.percept(cup, 3.0)], camera_view(), 3.0)
+    assert result.percept_symbols == ("cup_1",)
+    assert anchoring.get("cup_1").state is AnchorState.CONFIRMED
+    assert result.events[0].details["was_missing"] is True
+
+
+def test_never_confirmed_anchor_is_forgotten_sooner(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()  # forget_tentative_after = 1 s, forget_after = 5 s
+    anchoring.process([maker.percept(kitchen["apple"], 0.0)], camera_view(), 0.0)
+    anchoring.process([], camera_view(), FRAME)
+    assert anchoring.process([], camera_view(), 0.9).forgotten == ()
+    assert [a.symbol for a in anchoring.process([], camera_view(), 1.2).forgotten] == ["apple_1"]
+
+
+def test_tracker_id_continuity_holds_an_anchor_despite_a_jump(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    anchoring.process([maker.percept(cup, 0.0, tracker_id="7")], None, 0.0)
+    anchoring.process([maker.percept(cup, FRAME, tracker_id="7")], None, FRAME)
+    # 1 m away: the rule matcher alone would not match (score ~0), the continuing id does
+    moved = np.asarray(cup.position) + (0.0, 1.0, 0.0)
+    result = anchoring.process([maker.percept(cup, 2 * FRAME, tracker_id="7", position=moved)], None, 2 * FRAME)
+    assert result.percept_symbols == ("cup_1",)
+    assert result.events[0].details["tracker_continued"] is True
+
+
+def test_tracker_id_never_overrides_a_class_mismatch(maker, kitchen):
+    config = AnchoringConfig(
+        lifecycle=LifecycleConfig(confirm_after=1), table=MatchingTableConfig(gate_class_mismatch=False)
+    )
+    anchoring = Anchoring(config)
+    cup = kitchen["red_cup"]
+    anchoring.process([maker.percept(cup, 0.0, tracker_id="7")], None, 0.0)
+    # same place, same tracker id, but the detector now says "bowl": a different object
+    result = anchoring.process([maker.percept(cup, FRAME, tracker_id="7", class_name="bowl")], None, FRAME)
+    assert result.percept_symbols == ("bowl_1",)
+    assert anchoring.get("cup_1").times_seen == 1
+
+
+def test_an_empty_tracker_id_is_no_evidence(maker, kitchen):
+    anchoring = Anchoring(AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=1)))
+    cup = kitchen["red_cup"]
+    anchoring.process([maker.percept(cup, 0.0, tracker_id="")], None, 0.0)
+    moved = np.asarray(cup.position) + (0.0, 1.0, 0.0)
+    result = anchoring.process([maker.percept(cup, FRAME, tracker_id="", position=moved)], None, FRAME)
+    assert result.percept_symbols == ("cup_2",)
+
+
+def test_percept_in_another_frame_is_refused(make_anchoring, maker, kitchen):
+    import dataclasses
+
+    percept = dataclasses.replace(maker.percept(kitchen["red_cup"], 0.0), frame_id="base_link")
+    with pytest.raises(InvalidInputError, match="base_link"):
+        make_anchoring().process([percept], None, 0.0)
+
+
+def test_invalid_percept_geometry_is_refused(make_anchoring, maker, kitchen):
+    import dataclasses
+
+    percept = dataclasses.replace(maker.percept(kitchen["red_cup"], 0.0), position=np.array([np.nan, 0.0, 0.0]))
+    with pytest.raises(InvalidInputError, match="position"):
+        make_anchoring().process([percept], None, 0.0)
+
+
+def test_symbols_come_from_the_given_factory(maker, kitchen):
+    issued = []
+
+    def factory(class_name: str) -> str:
+        issued.append(class_name)
+        return f"{class_name}_{100 + len(issued)}"
+
+    anchoring = Anchoring(symbol_factory=factory)
+    result = anchoring.process([maker.percept(item, 0.0) for item in KITCHEN], None, 0.0)
+    assert result.percept_symbols == ("cup_101", "bowl_102", "apple_103")
+
+
+def test_symbols_from_a_knowledge_base_counter(maker, kitchen):
+    from merlin2_sailor.knowledge import open_store
+
+    with open_store() as knowledge_base:
+        anchoring = Anchoring(symbol_factory=knowledge_base.new_symbol)
+        result = anchoring.process([maker.percept(kitchen["red_cup"], 0.0)], None, 0.0)
+        assert result.percept_symbols == ("cup_1",)
+        assert knowledge_base.new_symbol("cup") == "cup_2"
+
+
+def test_a_factory_reusing_a_symbol_is_a_clear_error(maker, kitchen):
+    anchoring = Anchoring(symbol_factory=lambda class_name: "thing_1")
+    far_cup = SceneObject("far_cup", "cup", (9.0, 9.0, 0.8))
+    with pytest.raises(SailorError, match="never reuse"):
+        anchoring.process([maker.percept(kitchen["red_cup"], 0.0), maker.percept(far_cup, 0.0)], None, 0.0)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [{"match_threshold": 0.0}, {"match_threshold": 1.5}, {"world_frame": ""}, {"expectation_tolerance": -1.0}],
+)
+def test_invalid_configuration_is_refused(options):
+    with pytest.raises(ConfigurationError):
+        AnchoringConfig(**options)
+
+
+def test_twin_mugs_scene_is_in_view(twin_mugs):
+    # guards the scene library: both mugs project inside the test camera's image
+    from merlin2_sailor.anchoring.visibility import VisibilityConfig, should_be_visible
+
+    positions = np.array([item.position for item in TWIN_MUGS])
+    sizes = np.array([item.size for item in TWIN_MUGS])
+    assert should_be_visible(positions, sizes, camera_view(), VisibilityConfig()).all()

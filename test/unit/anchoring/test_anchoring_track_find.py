@@ -1,0 +1,246 @@
+"""Anchoring.track with expected effects, find, forget, and snapshots across a restart."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import (
+    AnchorEventKind,
+    Anchoring,
+    AnchorState,
+    Expectation,
+)
+from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.knowledge.model import Provenance
+from merlin2_sailor.perception.pose import Pose
+
+from .anchoring_scenes import KITCHEN, SceneObject, camera_view, flat_depth
+
+FRAME = 1.0 / 15.0
+
+
+def seen_twice(anchoring, maker, items, start=0.0):
+    for frame in range(2):
+        stamp = start + frame * FRAME
+        anchoring.process([maker.percept(item, stamp) for item in items], camera_view(), stamp)
+
+
+def event_kinds(result, symbol):
+    return [event.kind for event in result.events if event.symbol == symbol]
+
+
+# --- expected effects -----------------------------------------------------------------------
+
+
+def test_static_objects_stay_put_when_tracked(make_anchoring, maker):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, KITCHEN)
+    before = {a.symbol: a.position.copy() for a in anchoring.anchors}
+    result = anchoring.track(10.0, robot_pose=Pose.from_quaternion((0, 0, 0, 1), (5.0, 5.0, 0.0)))
+    assert result.events == ()
+    assert all(np.array_equal(a.position, before[a.symbol]) for a in anchoring.anchors)
+
+
+def test_carried_object_follows_the_robot(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, [kitchen["red_cup"]])
+    anchoring.process([], camera_view(yaw=math.pi), 1.0)  # look away: the cup is no longer visible
+    anchoring.expect("cup_1", Expectation.carried(1.0, offset=(0.3, 0.0, 0.9), source="pick"))
+    robot = Pose.from_quaternion((0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)), (4.0, 2.0, 0.0))
+    anchoring.track(2.0, robot_pose=robot)
+    cup = anchoring.get("cup_1")
+    np.testing.assert_allclose(cup.position, (4.0, 2.3, 0.9), atol=1e-9)  # robot faces +y
+    assert cup.provenance is Provenance.EXPECTED
+    found = anchoring.find(class_name="cup", near=np.array([4.0, 2.0, 0.0]))
+    assert found is cup
+
+
+def test_expected_place_confirmed_when_seen_there(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    seen_twice(anchoring, maker, [cup])
+    table = np.array([2.4, -0.8, 0.8])
+    anchoring.expect("cup_1", Expectation.at(table, stamp=1.0, place="table_wp", source="place"))
+    anchor = anchoring.get("cup_1")
+    assert np.array_equal(anchor.position, table) and anchor.provenance is Provenance.EXPECTED
+    moved = SceneObject("red_cup", "cup", tuple(table + (0.1, 0.05, 0.0)))
+    result = anchoring.process([maker.percept(moved, 2.0)], camera_view(), 2.0)
+    assert result.percept_symbols == ("cup_1",)
+    confirmed = [e for e in result.events if e.kind is AnchorEventKind.CONFIRMED]
+    assert confirmed and confirmed[0].details["reason"] == "expectation"
+    assert confirmed[0].details["expectation"]["place"] == "table_wp"
+    assert anchor.expectation is None and anchor.provenance is Provenance.PERCEIVED
+
+
+def test_expected_place_seen_empty_retracts_the_expectation(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, [kitchen["red_cup"]])
+    perceived = anchoring.get("cup_1").position.copy()
+    anchoring.expect("cup_1", Expectation.at((2.4, -0.8, 0.8), stamp=1.0, place="table_wp", source="place"))
+    result = anchoring.process([], camera_view(depth=flat_depth(6.0)), 2.0)
+    assert event_kinds(result, "cup_1") == [AnchorEventKind.RETRACTED]
+    assert result.events[0].details["reason"] == "expected place seen empty"
+    anchor = anchoring.get("cup_1")
+    assert anchor.expectation is None and anchor.provenance is Provenance.PERCEIVED
+    np.testing.assert_array_equal(anchor.position, perceived)  # back to where the camera last saw it
+    assert anchor.state is AnchorState.CONFIRMED  # a retraction is not a "missing"
+
+
+def test_expected_place_out_of_view_is_neither_confirmed_nor_retracted(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, [kitchen["red_cup"]])
+    anchoring.expect("cup_1", Expectation.at((-3.0, 0.0, 0.8), stamp=1.0))  # behind the camera
+    result = anchoring.process([], camera_view(), 2.0)
+    assert result.events == ()
+    assert anchoring.get("cup_1").expectation is not None
+
+
+def test_seen_far_from_the_expected_place_retracts_and_reacquires(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    seen_twice(anchoring, maker, [cup])
+    anchoring.expect("cup_1", Expectation.at((2.0, 1.6, 0.8), stamp=1.0, source="place"))
+    # seen 1.3 m from the expected place (beyond the 1 m tolerance), where it was before
+    result = anchoring.process([maker.percept(cup, 1.5, tracker_id="")], camera_view(), 1.5)
+    assert event_kinds(result, "cup_1")[:2] == [AnchorEventKind.RETRACTED, AnchorEventKind.REACQUIRED]
+    assert result.events[0].details["reason"] == "seen elsewhere"
+    assert anchoring.get("cup_1").expectation is None
+
+
+def test_an_expected_anchor_is_not_forgotten_while_missing(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, [kitchen["red_cup"]])
+    anchoring.process([], camera_view(), 1.0)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    anchoring.expect("cup_1", Expectation.carried(1.0))
+    assert anchoring.track(100.0).forgotten == ()
+    anchoring.clear_expectation("cup_1")
+    assert [a.symbol for a in anchoring.track(100.0).forgotten] == ["cup_1"]
+
+
+def test_expecting_an_unknown_symbol_is_a_clear_error(make_anchoring):
+    with pytest.raises(InvalidInputError, match="cup_9"):
+        make_anchoring().expect("cup_9", Expectation.at((0, 0, 0), stamp=0.0))
+
+
+def test_malformed_expectation_is_refused():
+    with pytest.raises(InvalidInputError):
+        Expectation.at((1.0, 2.0), stamp=0.0)
+
+
+# --- find and forget ------------------------------------------------------------------------
+
+
+def test_find_by_symbol_and_by_class(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, KITCHEN)
+    assert anchoring.find(symbol="bowl_1").class_name == "bowl"
+    assert anchoring.find(symbol="bowl_1", class_name="cup") is None
+    assert anchoring.find(symbol="bowl_7") is None
+    assert anchoring.find(class_name="apple").symbol == "apple_1"
+    assert anchoring.find(class_name="giraffe") is None
+
+
+def test_find_prefers_confirmed_then_nearest_then_recent(make_anchoring, maker):
+    anchoring = make_anchoring()
+    near_cup = SceneObject("near", "cup", (1.0, 0.0, 0.8))
+    far_cup = SceneObject("far", "cup", (4.0, 0.0, 0.8))
+    new_cup = SceneObject("new", "cup", (1.1, 2.0, 0.8))
+    seen_twice(anchoring, maker, [near_cup, far_cup])  # cup_1 (near) and cup_2 (far), confirmed
+    anchoring.process([maker.percept(new_cup, 0.5)], None, 0.5)  # cup_3, tentative, most recent
+    assert anchoring.find(class_name="cup", near=np.array([1.0, 2.0, 0.8])).symbol == "cup_1"
+    assert anchoring.find(class_name="cup", near=np.array([4.0, 0.5, 0.8])).symbol == "cup_2"
+    anchoring.process([maker.percept(far_cup, 0.6)], None, 0.6)
+    assert anchoring.find(class_name="cup").symbol == "cup_2"  # confirmed and seen most recently
+    assert anchoring.find(near=np.array([1.1, 2.0, 0.8])).symbol == "cup_1"  # confirmed beats tentative
+    with pytest.raises(InvalidInputError):
+        anchoring.find()
+
+
+def test_find_prefers_a_confirmed_anchor_over_a_missing_one(make_anchoring, maker):
+    anchoring = make_anchoring()
+    shelf_cup = SceneObject("shelf", "cup", (2.0, 0.0, 0.8))
+    hidden_cup = SceneObject("hidden", "cup", (-5.0, 0.0, 0.8))
+    seen_twice(anchoring, maker, [shelf_cup, hidden_cup])
+    anchoring.process([maker.percept(hidden_cup, 1.0)], camera_view(), 1.0)  # the shelf cup goes missing
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    assert anchoring.find(class_name="cup", near=np.array([2.0, 0.0, 0.8])).symbol == "cup_2"
+
+
+def test_forget_removes_the_anchor_and_reports_it(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, KITCHEN)
+    event = anchoring.forget("apple_1", stamp=3.0)
+    assert (event.kind, event.symbol, event.stamp) == (AnchorEventKind.FORGOTTEN, "apple_1", 3.0)
+    assert "apple_1" not in anchoring and anchoring.find(class_name="apple") is None
+    with pytest.raises(InvalidInputError, match="apple_1"):
+        anchoring.forget("apple_1")
+    # the apple seen again is a new anchor with a new symbol
+    result = anchoring.process([maker.percept(kitchen["apple"], 4.0)], None, 4.0)
+    assert result.percept_symbols == ("apple_2",)
+
+
+# --- snapshots ------------------------------------------------------------------------------
+
+
+def test_snapshot_restore_round_trip_survives_json(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, KITCHEN)
+    anchoring.expect("bowl_1", Expectation.at((1.0, 1.0, 0.8), stamp=0.5, place="sink", source="place"))
+    snapshot = json.loads(json.dumps(anchoring.snapshot()))
+
+    restarted = make_anchoring()
+    restarted.restore(snapshot)
+    assert {a.symbol for a in restarted.anchors} == {"cup_1", "bowl_1", "apple_1"}
+    for original in anchoring.anchors:
+        copy = restarted.get(original.symbol)
+        np.testing.assert_array_equal(copy.position, original.position)
+        np.testing.assert_array_equal(copy.size, original.size)
+        np.testing.assert_array_equal(copy.gallery, original.gallery)
+        assert (copy.state, copy.times_seen, copy.class_votes, copy.last_seen, copy.provenance) == (
+            original.state, original.times_seen, original.class_votes, original.last_seen, original.provenance
+        )
+        assert copy.visible is False
+    assert restarted.get("bowl_1").expectation.place == "sink"
+    # the restored anchors are matched, and the default counter does not reissue their symbols
+    another_cup = SceneObject("another_cup", "cup", (8.0, 8.0, 0.8))
+    result = restarted.process([maker.percept(kitchen["red_cup"], 1.0), maker.percept(another_cup, 1.0)], None, 1.0)
+    assert result.percept_symbols == ("cup_1", "cup_2")
+
+
+def test_restore_refuses_foreign_or_corrupt_snapshots(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, KITCHEN)
+    good = anchoring.snapshot()
+    with pytest.raises(InvalidInputError, match="format"):
+        make_anchoring().restore({"anchors": []})
+    with pytest.raises(InvalidInputError, match="version"):
+        make_anchoring().restore({**good, "version": 99})
+    with pytest.raises(InvalidInputError, match="frame"):
+        make_anchoring().restore({**good, "world_frame": "odom"})
+    broken = {**good, "anchors": [{**good["anchors"][0], "position": [1.0, "x", 2.0]}]}
+    with pytest.raises(InvalidInputError, match=good["anchors"][0]["symbol"]):
+        make_anchoring().restore(broken)
+    twice = {**good, "anchors": [good["anchors"][0], good["anchors"][0]]}
+    with pytest.raises(InvalidInputError, match="twice"):
+        make_anchoring().restore(twice)
+
+
+def test_restore_replaces_existing_anchors(make_anchoring, maker, kitchen):
+    source = make_anchoring()
+    source.process([maker.percept(kitchen["apple"], 0.0)], None, 0.0)
+    target = make_anchoring()
+    target.process([maker.percept(item, 0.0) for item in KITCHEN], None, 0.0)
+    target.restore(source.snapshot())
+    assert [a.symbol for a in target.anchors] == ["apple_1"]
+    assert target.find(class_name="cup") is None
+
+
+def test_snapshot_without_anchors_restores_to_empty():
+    anchoring = Anchoring()
+    anchoring.restore(Anchoring().snapshot())
+    assert len(anchoring) == 0
