@@ -4,16 +4,23 @@
 # Other targets: make setup, make clean.
 SHELL := /bin/bash
 VENV := .venv
-DEMO_DURATION ?= 10
+DEMO_DURATION ?= 20
+DEMO_DATA := reports/demo
 
 .PHONY: setup demo test clean
 
 setup:
 	@scripts/setup.sh
 
+# The whole graph on a real RGB-D frame for DEMO_DURATION seconds, from an empty world each time;
+# then what the robot now knows: the knowledge base it left behind.
 demo: setup
-	@ROS_AUTOMATIC_DISCOVERY_RANGE=$${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST} \
-		$(VENV)/bin/sailor launch camera --duration $(DEMO_DURATION)
+	@rm -rf $(DEMO_DATA) && mkdir -p $(DEMO_DATA)
+	@export ROS_AUTOMATIC_DISCOVERY_RANGE=$${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST} \
+		SAILOR_DATA=$(CURDIR)/$(DEMO_DATA) && \
+		$(VENV)/bin/sailor launch sailor --duration $(DEMO_DURATION) && \
+		echo && echo "What the robot knows now (sailor knowledge show --store sqlite://$(DEMO_DATA)/knowledge.db):" && \
+		$(VENV)/bin/sailor knowledge show --store sqlite://$(CURDIR)/$(DEMO_DATA)/knowledge.db
 
 test: setup
 	@SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest

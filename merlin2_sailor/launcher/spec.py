@@ -21,6 +21,7 @@ Errors name the file and the offending entry, because a launch file is usually e
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
@@ -145,7 +146,7 @@ def _parse_parameters(
     parameters: list[Path | dict[str, Any]] = []
     for entry in raw:
         if isinstance(entry, dict):
-            parameters.append({str(key): value for key, value in entry.items()})
+            parameters.append({str(key): _expand_values(value) for key, value in entry.items()})
         elif isinstance(entry, str):
             file = Path(_expand(entry))
             file = file if file.is_absolute() else (base_directory / file).resolve()
@@ -184,6 +185,33 @@ def _reject_unknown_keys(raw: dict[str, Any], allowed: set[str], where: str) -> 
         )
 
 
+_VARIABLE = re.compile(r"\$\{(?P<name>[A-Za-z_][A-Za-z0-9_]*)(?::-(?P<default>[^}]*))?\}")
+
+
 def _expand(text: str) -> str:
-    """Expand ${VARIABLE} and ~ so launch files can refer to the user's environment."""
-    return os.path.expanduser(os.path.expandvars(text))
+    """Expand ``${VARIABLE}``, ``${VARIABLE:-default}`` and a leading ``~``.
+
+    An unset variable without a default is an error: left as text, it would silently become a
+    file or folder literally named ``${VARIABLE}``.
+    """
+
+    def substitute(match: re.Match[str]) -> str:
+        name, default = match.group("name"), match.group("default")
+        if name in os.environ:
+            return os.environ[name]
+        if default is not None:
+            return os.path.expanduser(default)
+        raise ConfigurationError(
+            f"environment variable {name} is not set; set it, or write ${{{name}:-default}}"
+        )
+
+    return os.path.expanduser(_VARIABLE.sub(substitute, text))
+
+
+def _expand_values(value: Any) -> Any:
+    """Expand variables in every string of an inline parameter value (lists included)."""
+    if isinstance(value, str):
+        return _expand(value)
+    if isinstance(value, list):
+        return [_expand_values(item) for item in value]
+    return value

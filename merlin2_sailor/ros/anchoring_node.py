@@ -31,6 +31,7 @@ from visualization_msgs.msg import MarkerArray
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_view import views_of
 from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig, AnchoringResult
+from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, PersistenceWorker
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
@@ -249,6 +250,12 @@ class AnchoringNode(Node):
         class_names.update({anchor.symbol: anchor.class_name for anchor in result.forgotten})
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
         self._events_publisher.publish(events_to_message(result.events, class_names, header))
+        for event in result.events:  # a running account; reacquisitions would flood it
+            if event.kind is not AnchorEventKind.REACQUIRED:
+                details = ", ".join(f"{key}={value}" for key, value in event.details.items())
+                self.get_logger().info(
+                    f"{event.kind.value} {event.symbol} ({class_names.get(event.symbol, '?')})"
+                    + (f": {details}" if details else ""))
         self._publish_state()
 
     def _publish_state(self) -> None:

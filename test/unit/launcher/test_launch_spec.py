@@ -95,3 +95,20 @@ def test_command_line_carries_name_namespace_parameters_and_remappings(tmp_path:
 def test_unknown_executable_names_the_places_searched() -> None:
     with pytest.raises(ConfigurationError, match="not found"):
         resolve_executable("no_such_node_anywhere")
+
+
+def test_variables_expand_in_inline_values_with_defaults_and_unset_ones_are_errors(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("SAILOR_TEST_DATA", "/data")
+    monkeypatch.delenv("SAILOR_TEST_UNSET", raising=False)
+    spec = parse_launch_document({"nodes": [{"executable": "a", "parameters": [{
+        "store": "sqlite://${SAILOR_TEST_DATA}/kb.db",
+        "folder": "${SAILOR_TEST_UNSET:-/fallback}/anchors",
+        "topics": ["${SAILOR_TEST_DATA}/a", "b"], "rate": 5.0,
+    }]}]}, base_directory=tmp_path)
+    assert spec.nodes[0].parameters[0] == {
+        "store": "sqlite:///data/kb.db", "folder": "/fallback/anchors", "topics": ["/data/a", "b"], "rate": 5.0}
+    with pytest.raises(ConfigurationError, match="SAILOR_TEST_UNSET is not set"):
+        parse_launch_document({"nodes": [{"executable": "a", "parameters": [
+            {"store": "${SAILOR_TEST_UNSET}/kb.db"}]}]}, base_directory=tmp_path)
