@@ -14,6 +14,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 
 from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.perception.depth import depth_to_metres  # noqa: F401 - re-exported for nodes
 
 # encoding -> (dtype, channels)
 IMAGE_ENCODINGS: dict[str, tuple[np.dtype, int]] = {
@@ -80,21 +81,6 @@ def array_to_image(array: np.ndarray, encoding: str, header: Header | None = Non
     message.step = int(contiguous.shape[1] * channels * dtype.itemsize)
     message.data = contiguous.tobytes()
     return message
-
-
-def depth_to_metres(depth: np.ndarray, encoding: str) -> np.ndarray:
-    """Convert a depth image to float32 metres; zero and non-finite depths become NaN.
-
-    16-bit depth images are in millimetres (REP 118); 32-bit float images are in metres.
-    """
-    if encoding in ("16UC1", "mono16"):
-        metres = depth.astype(np.float32) * np.float32(0.001)
-    elif encoding == "32FC1":
-        metres = depth.astype(np.float32, copy=True)
-    else:
-        raise InvalidInputError(f"depth encoding '{encoding}' is not supported (16UC1 mm or 32FC1 m)")
-    metres[~np.isfinite(metres) | (metres <= 0.0)] = np.nan
-    return metres
 
 
 def stamp_to_seconds(stamp: Time) -> float:
