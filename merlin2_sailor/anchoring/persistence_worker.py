@@ -73,11 +73,14 @@ class PersistenceWorker:
         self._thread.start()
 
     def stop(self) -> None:
-        """Stop the thread, then save and sync one last time."""
+        """Stop the thread; save, then sync one last time (the save first: it matters more)."""
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join(timeout=30.0)
-        self.step(force_save=True)
+        anchors = self._copy_anchors()
+        self._save(anchors)
+        self._guarded(lambda: self._sync_knowledge_base(anchors.views))
+        self._save(anchors)  # with the objects the last sync may have created
         if self._sync is not None:
             self._sync.close()
         if self._store is not None:
@@ -86,22 +89,33 @@ class PersistenceWorker:
     def step(self, force_save: bool = False) -> None:
         """One round: sync the knowledge base, and save the state file when due."""
         anchors = self._copy_anchors()
-        if self._open_knowledge_base is not None and self._grounding is not None:
-            self._sync_knowledge_base(anchors.views)
-        now = time.monotonic()
-        if self._state_file is not None and (force_save or now >= self._next_save):
-            self._next_save = now + self._save_period
-            try:
-                self._state_file.save_anchors(anchors.snapshot(), self._owned)
-            except OSError as error:
-                self._log("error", f"cannot save anchors to {self._state_file.folder}: {error}")
+        self._sync_knowledge_base(anchors.views)
+        if force_save or time.monotonic() >= self._next_save:
+            self._save(anchors)
+
+    def _save(self, anchors: AnchorsCopy) -> None:
+        if self._state_file is None:
+            return
+        self._next_save = time.monotonic() + self._save_period
+        try:
+            self._state_file.save_anchors(anchors.snapshot(), self._owned)
+        except OSError as error:
+            self._log("error", f"cannot save anchors to {self._state_file.folder}: {error}")
 
     def _run(self) -> None:
         while not self._stop.wait(self._sync_period):
-            self.step()
+            self._guarded(self.step)
+
+    def _guarded(self, work: Callable[[], None]) -> None:
+        """Run ``work``; an unexpected error is logged, because this thread must outlive it."""
+        try:
+            work()
+        except Exception as error:  # noqa: BLE001 - the worker keeps the anchors safe; it must not die
+            self._log("error", f"anchoring persistence step failed, retrying: {error!r}")
 
     def _sync_knowledge_base(self, views: Sequence[AnchorView]) -> None:
-        assert self._open_knowledge_base is not None and self._grounding is not None
+        if self._open_knowledge_base is None or self._grounding is None:
+            return
         try:
             if self._store is None:
                 self._store = self._open_knowledge_base()

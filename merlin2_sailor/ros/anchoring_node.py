@@ -129,7 +129,9 @@ class AnchoringNode(Node):
         self._worker = PersistenceWorker(
             self._copy_anchors, self._state_file, self._knowledge_base_opener(knowledge_base),
             Grounding(GroundingConfig.from_yaml(grounding_file or config_file("grounding.yaml"))),
-            owned_objects=saved.owned_objects if saved else frozenset(),
+            # Restored anchors are this node's objects in the knowledge base, saved as owned or not.
+            owned_objects=(saved.owned_objects if saved else frozenset())
+            | {anchor.symbol for anchor in self._anchoring.anchors},
             sync_period=sync_period, save_period=save_period, log=self._log,
         )
         self._worker.start()

@@ -19,6 +19,7 @@ from typing import Any
 import rclpy
 from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import KnowledgeChanges
+from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
 from merlin2_sailor.errors import KnowledgeError
@@ -163,6 +164,15 @@ class RemoteKnowledgeBase(KnowledgeBase):
     def _call(self, service_type: Any, service: str, request: Any) -> Any:
         if self._closed:
             raise KnowledgeError("this knowledge-base client is closed")
+        if not self._context.ok():
+            # Ctrl-C shuts every ROS context of the process down, this client's included.
+            raise KnowledgeError("the ROS context of this knowledge-base client has shut down")
+        try:
+            return self._call_service(service_type, service, request)
+        except (RCLError, InvalidHandle) as error:  # the context went down during the call
+            raise KnowledgeError(f"the knowledge-base client's ROS context failed: {error}") from error
+
+    def _call_service(self, service_type: Any, service: str, request: Any) -> Any:
         name = self._name(service)
         with self._clients_lock:
             client = self._clients.get(name)

@@ -1,0 +1,115 @@
+"""The anchoring node's persistence, without ROS: state file, frozen views, and the worker that
+syncs the knowledge base and saves anchors off the hot path."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_view import AnchorView, views_of
+from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, PersistenceWorker
+from merlin2_sailor.anchoring.state_file import AnchoringStateFile
+from merlin2_sailor.errors import ConfigurationError, KnowledgeError
+from merlin2_sailor.knowledge import Grounding, GroundingConfig, open_store
+
+GROUNDING = Grounding(GroundingConfig.from_mapping({
+    "map": {"waypoints": [{"name": "kitchen", "x": 1.0, "y": 0.0}]}, "ungrounded_states": ["forgotten"]}))
+
+
+def anchor(symbol: str, x: float) -> Anchor:
+    return Anchor(symbol=symbol, class_name=symbol.rsplit("_", 1)[0], position=np.array([x, 0.0, 0.8]),
+                  size=np.array([0.1, 0.1, 0.1]), first_seen=1.0, last_seen=2.0, state=AnchorState.CONFIRMED)
+
+
+class FlakyStore:
+    """A knowledge base that can be made to fail, and restarted empty."""
+
+    def __init__(self) -> None:
+        self.store = open_store("memory")
+        self.down = False
+        self.opened = 0
+
+    def open(self):
+        self.opened += 1
+        outer = self
+
+        class Proxy:
+            def __getattr__(self, name):
+                if outer.down:
+                    raise KnowledgeError("knowledge base unreachable")
+                return getattr(outer.store, name)
+
+        return Proxy()
+
+    def restart_empty(self) -> None:
+        self.store = open_store("memory")
+
+
+def test_state_file_round_trip_and_atomic_replacement(tmp_path) -> None:
+    state = AnchoringStateFile(tmp_path / "state")
+    assert state.load().snapshot is None  # a first run
+    state.save_symbols({"cup": 3})
+    state.save_anchors({"format": "x", "anchors": []}, frozenset({"cup_1"}))
+    loaded = state.load()
+    assert (loaded.symbol_indices, loaded.owned_objects) == ({"cup": 3}, frozenset({"cup_1"}))
+    assert sorted(path.name for path in (tmp_path / "state").iterdir()) == ["anchors.json", "symbols.json"]
+
+
+def test_a_damaged_state_file_is_a_clear_error(tmp_path) -> None:
+    state = AnchoringStateFile(tmp_path)
+    (tmp_path / "anchors.json").write_text("{truncated")
+    with pytest.raises(ConfigurationError, match="damaged"):
+        state.load()
+    (tmp_path / "anchors.json").write_text(json.dumps({"format": 99}))
+    with pytest.raises(ConfigurationError, match="format"):
+        state.load()
+
+
+def test_views_are_frozen_copies() -> None:
+    live = anchor("cup_1", 1.0)
+    (view,) = views_of([live])
+    live.position[0] = 5.0
+    assert isinstance(view, AnchorView) and view.position[0] == 1.0
+    with pytest.raises(ValueError):
+        view.position[0] = 2.0
+
+
+def test_worker_keeps_anchors_through_an_outage_and_fills_a_restarted_knowledge_base(tmp_path) -> None:
+    anchors = [anchor("cup_1", 1.0)]
+    copy = lambda: AnchorsCopy(views_of(anchors), lambda: {"anchors": [a.symbol for a in anchors]})  # noqa: E731
+    kb, logs = FlakyStore(), []
+    worker = PersistenceWorker(copy, AnchoringStateFile(tmp_path), kb.open, GROUNDING,
+                               log=lambda level, message: logs.append((level, message)))
+    worker.step()
+    assert kb.store.objects.get("cup_1") is not None
+
+    kb.down = True
+    anchors.append(anchor("book_1", 1.2))
+    worker.step()
+    worker.step()
+    assert [level for level, _ in logs] == ["error"]  # said once, not every period
+    assert "anchors are kept" in logs[0][1]
+
+    kb.restart_empty()  # it came back, having lost everything
+    kb.down = False
+    worker.step()
+    assert {o.name for o in kb.store.objects.get_all()} >= {"cup_1", "book_1"}
+    assert logs[-1][0] == "info"
+    assert worker.owned_objects >= {"cup_1", "book_1"}
+
+
+def test_stop_saves_the_anchors_even_when_the_knowledge_base_breaks_unexpectedly(tmp_path) -> None:
+    def broken_knowledge_base():
+        raise RuntimeError("a bug somewhere below")
+
+    state = AnchoringStateFile(tmp_path)
+    logs = []
+    worker = PersistenceWorker(lambda: AnchorsCopy(views_of([anchor("cup_1", 1.0)]), lambda: {"anchors": ["cup_1"]}),
+                               state, broken_knowledge_base, GROUNDING,
+                               log=lambda level, message: logs.append(level))
+    worker.stop()
+    assert state.load().snapshot == {"anchors": ["cup_1"]}
+    assert "error" in logs
