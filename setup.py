@@ -43,6 +43,7 @@ setup(
         (f"share/{PACKAGE_NAME}/config", glob("config/*")),
         (f"share/{PACKAGE_NAME}/launch", glob("launch/*")),
     ],
+    package_data={"merlin2_sailor": ["models/*.pt", "models/*.json"]},
     install_requires=["setuptools"],
     zip_safe=True,
     maintainer="merlin2_sailor developers",

@@ -19,6 +19,8 @@ SUBCOMMANDS = (
     "merlin2_sailor.cli.launch_command",
     "merlin2_sailor.cli.knowledge_command",
     "merlin2_sailor.cli.anchors_command",
+    "merlin2_sailor.cli.train_command",
+    "merlin2_sailor.cli.evaluate_command",
 )
 
 

@@ -1,0 +1,134 @@
+"""Anchoring-level identity metrics: run the whole anchoring layer over generated sequences.
+
+Pair metrics say how well M scores pairs in isolation; what a robot feels is whether each
+physical object keeps one symbol. Every scene is replayed through a fresh
+:class:`~merlin2_sailor.anchoring.anchoring.Anchoring` (gating, Hungarian assignment, fusion,
+galleries: everything) and the symbol given to each percept is compared with the percept's
+ground-truth instance by motmetrics, as a multi-object tracker would be: each percept is both a
+ground-truth object and a hypothesis, so the scores measure identity only (ID switches, IDF1),
+never detection. Percepts carry their crop's cached embedding, so no crop is embedded twice.
+
+No camera view is passed (there is no depth image): anchors are never marked missing, which
+leaves the identity decisions, the subject here, unchanged.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.errors import DependencyError
+from merlin2_sailor.training.embedding_cache import EmbeddingCache
+from merlin2_sailor.training.generated_scenes import Scene
+
+
+@dataclass(frozen=True, slots=True)
+class IdentityMetrics:
+    """Over all scenes: ``instances`` (ground-truth objects), ``anchors`` (symbols created; equal
+    to ``instances`` when nothing was split), ``id_switches``, ``idf1`` / ``idp`` / ``idr``, ``mota``."""
+
+    scenes: int
+    percepts: int
+    instances: int
+    anchors: int
+    id_switches: int
+    idf1: float
+    idp: float
+    idr: float
+    mota: float
+
+    def as_dict(self) -> dict[str, float | int]:
+        return asdict(self)
+
+
+def motmetrics_module():  # type: ignore[no-untyped-def]
+    """Import motmetrics; 1.4 calls ``np.asfarray``, gone in NumPy 2, so it is provided if missing."""
+    if not hasattr(np, "asfarray"):
+        np.asfarray = lambda values, dtype=np.float64: np.asarray(values, dtype=dtype)  # type: ignore[attr-defined]
+    try:
+        import motmetrics
+    except ImportError as error:
+        raise DependencyError(f"Anchoring-level metrics need motmetrics (`pip install motmetrics`): {error}") from error
+    return motmetrics
+
+
+def evaluate_identities(
+    matcher_factory: Callable[[], Matcher],
+    scenes: Iterable[Scene],
+    cache: EmbeddingCache | None = None,
+    config: AnchoringConfig | None = None,
+) -> IdentityMetrics:
+    """Replay ``scenes`` through a fresh Anchoring each (matcher from ``matcher_factory``)."""
+    motmetrics = motmetrics_module()
+    accumulators, names = [], []
+    percept_count = instances = anchors = 0
+    for scene in scenes:
+        matcher = matcher_factory()
+        anchoring = Anchoring(config, matcher)
+        accumulator = motmetrics.MOTAccumulator(auto_id=True)
+        symbol_numbers: dict[str, int] = {}  # motmetrics wants numeric hypothesis ids
+        instances_seen: set[int] = set()
+        for sample in scene.samples:
+            observations = sample.observations
+            embeddings = None
+            if matcher.uses_appearance and observations:
+                if cache is None:
+                    raise DependencyError("An appearance matcher needs the embedding cache of the scenes' crops.")
+                embeddings = cache.lookup([o.crop_id for o in observations])
+            percepts = [
+                Percept(
+                    class_name=o.class_name,
+                    score=0.9,
+                    box=BoundingBox2D(0.0, 0.0, float(o.view.pixels[0]), float(o.view.pixels[1])),
+                    position=o.position,
+                    size=o.size,
+                    stamp=sample.stamp,
+                    embedding=None if embeddings is None else embeddings[row],
+                )
+                for row, o in enumerate(observations)
+            ]
+            result = anchoring.process(percepts, None, sample.stamp)
+            truth = [o.instance for o in observations]
+            hypotheses = [symbol_numbers.setdefault(s, len(symbol_numbers)) for s in result.percept_symbols]
+            distances = np.full((len(truth), len(hypotheses)), np.nan)
+            np.fill_diagonal(distances, 0.0)
+            accumulator.update(truth, hypotheses, distances)
+            instances_seen.update(truth)
+            percept_count += len(observations)
+        accumulators.append(accumulator)
+        names.append(scene.scene_id)
+        instances += len(instances_seen)
+        anchors += len(symbol_numbers)
+    if not accumulators:
+        raise DependencyError("No scenes to evaluate identities on.")
+    summary = motmetrics.metrics.create().compute_many(
+        accumulators, metrics=["num_switches", "idf1", "idp", "idr", "mota"], names=names, generate_overall=True
+    )
+    overall = summary.loc["OVERALL"]
+    return IdentityMetrics(
+        scenes=len(accumulators),
+        percepts=percept_count,
+        instances=instances,
+        anchors=anchors,
+        id_switches=int(overall["num_switches"]),
+        idf1=float(overall["idf1"]),
+        idp=float(overall["idp"]),
+        idr=float(overall["idr"]),
+        mota=float(overall["mota"]),
+    )
+
+
+def format_identity_table(rows: dict[str, IdentityMetrics]) -> str:
+    width = max([len(name) for name in rows] + [8])
+    lines = [f"{'':<{width}}  {'percepts':>8} {'objects':>8} {'anchors':>8} {'ID sw.':>7} {'IDF1':>7} {'IDP':>7} {'IDR':>7} {'MOTA':>7}"]
+    for name, m in rows.items():
+        lines.append(
+            f"{name:<{width}}  {m.percepts:>8d} {m.instances:>8d} {m.anchors:>8d} {m.id_switches:>7d} "
+            f"{m.idf1:>7.4f} {m.idp:>7.4f} {m.idr:>7.4f} {m.mota:>7.4f}"
+        )
+    return "\n".join(lines)

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Make the matching-network weights that ship in merlin2_sailor/models/, from the generated source
+# (real photo crops from scikit-image and Debian's darknet package; see
+# merlin2_sailor/training/generated_scenes.py), then evaluate them on held-out test scenes.
+# Deterministic given the seed (up to floating-point differences between machines).
+# Embeddings are cached under $SAILOR_CACHE (default ~/.cache/merlin2_sailor), so a second run is faster.
+# Usage: scripts/make_default_weights.sh            (about 2-5 minutes on 2 CPU cores)
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+python="${PYTHON:-$root/.venv/bin/python}"
+export SAILOR_DARKNET_DATA="${SAILOR_DARKNET_DATA:-$(scripts/fetch_test_data.sh)}"
+if [ ! -f "$SAILOR_DARKNET_DATA/dog.jpg" ]; then
+  echo "make_default_weights: darknet photos not found (scripts/fetch_test_data.sh failed)" >&2
+  exit 1
+fi
+weights="merlin2_sailor/models/matching_network_efficientnet_lite0.pt"
+
+"$python" -m merlin2_sailor.cli.main train --seed 0 --output "$weights"
+# The loss curve is a build product, not package data: keep it in build/.
+mkdir -p build/default_weights
+mv -f "${weights%.pt}_loss.png" build/default_weights/loss.png
+"$python" -m merlin2_sailor.cli.main evaluate --seed 0 --weights "$weights" --output build/default_weights

@@ -1,0 +1,45 @@
+"""``sailor train`` and ``sailor evaluate`` end to end, on a few generated scenes."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("torch", reason="pip install torch==2.13.0 (CPU build)")
+
+from merlin2_sailor.cli.main import build_parser, main  # noqa: E402
+from merlin2_sailor.training.photo_library import DARKNET_ENVIRONMENT_VARIABLE, DEFAULT_DARKNET_FOLDER  # noqa: E402
+
+darknet = Path(os.environ.get(DARKNET_ENVIRONMENT_VARIABLE) or DEFAULT_DARKNET_FOLDER)
+needs_darknet = pytest.mark.skipif(not (darknet / "dog.jpg").is_file(), reason="run scripts/fetch_test_data.sh")
+
+
+def test_both_subcommands_are_registered() -> None:
+    arguments = build_parser().parse_args(["train", "--epochs", "2"])
+    assert arguments.epochs == 2 and arguments.learning_rate == 0.001
+    assert build_parser().parse_args(["evaluate"]).split == "test"
+
+
+@needs_darknet
+def test_train_then_evaluate_a_few_scenes(tmp_path, capsys) -> None:
+    weights = tmp_path / "net.pt"
+    cache = ["--cache", str(tmp_path / "cache")]
+    assert main(["train", "--train-scenes", "2", "--validation-scenes", "1", "--epochs", "2",
+                 "--output", str(weights), "--device", "cpu", *cache]) == 0
+    assert weights.is_file() and (tmp_path / "net_loss.png").is_file()
+    assert json.loads(weights.with_suffix(".json").read_text())["splits"] == {"train": 2, "validation": 1, "test": 0}
+    assert main(["evaluate", "--weights", str(weights), "--scenes", "1", "--output", str(tmp_path / "eval"),
+                 *cache]) == 0
+    output = capsys.readouterr().out
+    assert "network look-alike" in output and "IDF1" in output
+    report = json.loads((tmp_path / "eval" / "metrics.json").read_text())
+    assert set(report["pairs"]) == {"network", "rules", "network look-alike", "rules look-alike"}
+    assert (tmp_path / "eval" / "confusion.png").is_file()
+
+
+def test_a_weights_file_that_does_not_exist_is_one_clear_error(tmp_path, capsys) -> None:
+    assert main(["evaluate", "--weights", str(tmp_path / "missing.pt")]) == 2
+    assert "not found" in capsys.readouterr().err
