@@ -69,7 +69,8 @@ class AnchoringNode(Node):
         matcher = declare_parameter(
             self, "matcher", "rules",
             "Matching function: 'rules' (class, distance, time) or 'network' (the learned one).")
-        weights = declare_parameter(self, "weights", "", "Matching network weights file (matcher 'network').")
+        weights = declare_parameter(
+            self, "weights", "", "Matching network weights (matcher 'network'); '' uses the shipped ones.")
         backbone = declare_parameter(
             self, "backbone", "efficientnet_lite0", "Crop backbone the network was trained with.")
         knowledge_base = declare_parameter(
@@ -101,6 +102,8 @@ class AnchoringNode(Node):
         self._anchoring = Anchoring(
             AnchoringConfig(world_frame=world_frame),
             matcher=self._make_matcher(matcher, weights, backbone),
+            # The network compares crops, so it needs them embedded; the rules never look at them.
+            embedder=self._make_embedder(backbone) if matcher == "network" else None,
             symbol_factory=self._new_symbol,
         )
         if saved and saved.snapshot:
@@ -150,12 +153,16 @@ class AnchoringNode(Node):
         if name == "rules":
             return RuleMatcher()
         if name == "network":
-            if not weights:
-                raise ConfigurationError("matcher 'network' needs the 'weights' parameter (a weights file)")
             from merlin2_sailor.anchoring.matching_network import NetworkMatcher
+            from merlin2_sailor.models import default_weights_path
 
-            return NetworkMatcher.from_file(weights, backbone)
+            return NetworkMatcher.from_file(weights or default_weights_path(), backbone)
         raise ConfigurationError(f"unknown matcher '{name}'; use 'rules' or 'network'")
+
+    def _make_embedder(self, backbone: str) -> Any:
+        from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
+
+        return CropEmbedder(EmbeddingConfig(backbone=backbone))
 
     def _knowledge_base_opener(self, location: str) -> Any:
         if not location:

@@ -13,6 +13,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 import rclpy
+from rclpy._rclpy_pybind11 import RCLError
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
 
@@ -30,7 +31,12 @@ def run_node(
     wait behind long subscription callbacks. A SailorError while building the node (a bad
     parameter, a missing model file) is logged as one line and exits with code 2.
     """
-    rclpy.init(args=list(argv) if argv is not None else sys.argv)
+    arguments = list(argv) if argv is not None else sys.argv
+    try:
+        rclpy.init(args=arguments)
+    except RCLError as error:  # a malformed --ros-args: say so in one line, not a traceback
+        print(f"cannot start: invalid ROS arguments {arguments[1:]}: {error}", file=sys.stderr, flush=True)
+        return 2
     # SIGTERM (the launcher's second step, systemd, docker stop) shuts down like Ctrl-C.
     signal.signal(signal.SIGTERM, lambda *_: rclpy.try_shutdown())
     node: Node | None = None

@@ -148,3 +148,17 @@ def test_anchoring_over_dds_with_the_knowledge_base_and_a_restart(tmp_path, ros_
         assert cups.count("cup_1") == 1
     assert anchoring.stop() == 0, anchoring.text
     assert knowledge_base.stop() == 0, knowledge_base.text
+
+
+def test_the_network_matcher_starts_with_the_shipped_weights_and_anchors(tmp_path, ros_probe, node_process) -> None:
+    anchoring = node_process("anchoring", "--ros-args", "-p", "matcher:=network", "-p", "knowledge_base:=''",
+                             "-p", f"state_folder:={tmp_path}")
+    assert ros_probe.wait_for_node("/anchoring", timeout=30.0), anchoring.text
+    camera = PerceptionStandIn(ros_probe)
+    time.sleep(1.0)
+    for _ in range(3):
+        camera.frame([CUP, BOOK])
+    assert ros_probe.wait_for(lambda: sorted(latest_anchors(ros_probe)) == ["book_1", "cup_1"], timeout=20.0), \
+        anchoring.text
+    assert anchoring.stop() == 0, anchoring.text
+    assert "with the network matcher" in anchoring.text

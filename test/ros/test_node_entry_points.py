@@ -32,3 +32,10 @@ def test_node_starts_joins_the_graph_and_shuts_down_cleanly(executable, ros_prob
     assert exit_code == 0, process.text
     assert "Traceback" not in process.text
     assert ros_probe.wait_for(lambda: f"/{node_name}" not in ros_probe.node_names(), timeout=10.0)
+
+
+def test_malformed_ros_arguments_are_one_line_not_a_traceback(node_process) -> None:
+    process = node_process("topic_monitor", "--ros-args", "-p", "window:=")
+    process.process.wait(timeout=30.0)
+    assert process.stop() == 2
+    assert "invalid ROS arguments" in process.text and "Traceback" not in process.text
