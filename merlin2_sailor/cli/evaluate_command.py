@@ -6,7 +6,8 @@ scored side by side: the confusion matrix and accuracy / precision / recall / F1
 and over the look-alike pairs (same class, near). Then each scene is replayed through the whole
 anchoring layer with each matcher and the symbols are scored against the ground truth (ID
 switches, IDF1, via motmetrics). Text on stdout; with ``--output``, a confusion-matrix PNG and
-a JSON of every number.
+a JSON of every number. ``--source`` evaluates on a public data set's split instead (see
+``sailor train``).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import time
 from dataclasses import asdict
 from pathlib import Path
 
-from merlin2_sailor.cli.train_command import embedding_cache, generated_source
+from merlin2_sailor.cli.train_command import SOURCE_HELP, embedding_cache, pair_source
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -28,7 +29,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--weights", default="", metavar="PATH",
                         help="weights file (default: the weights shipped in merlin2_sailor/models)")
-    parser.add_argument("--split", default="test", help="generated split to evaluate on (default test)")
+    parser.add_argument("--source", default="generated", metavar="SPEC", help=SOURCE_HELP)
+    parser.add_argument("--split", default="test",
+                        help="split to evaluate on (default test; a public data set also has 'all')")
     parser.add_argument("--scenes", type=int, default=30, metavar="N", help="scenes of the split (default 30)")
     parser.add_argument("--first", type=int, default=0, metavar="I", help="first scene index (default 0)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated source (default 0)")
@@ -56,7 +59,7 @@ def run(arguments: argparse.Namespace) -> int:
     started = time.perf_counter()
     weights = Path(arguments.weights) if arguments.weights else default_weights_path()
     network = load_network(weights, DEFAULT_BACKBONE)
-    source = generated_source(arguments)
+    source = pair_source(arguments)
     pair_set = GeneratedPairSet(source, arguments.split, arguments.scenes, PairDatasetConfig(), arguments.first)
     cache = embedding_cache(arguments, network.metadata.backbone)
     pair_set.embed(cache)
@@ -94,6 +97,7 @@ def run(arguments: argparse.Namespace) -> int:
         image = plot_confusions(folder / "confusion.png", table)
         report = {
             "weights": str(weights),
+            "source": arguments.source,
             "split": arguments.split, "scenes": arguments.scenes, "first": arguments.first, "seed": arguments.seed,
             "pairs": {name: counts.as_dict() for name, counts in table.items()},
             "anchoring": {name: metrics.as_dict() for name, metrics in identities.items()},

@@ -4,7 +4,9 @@ Steps: generate the train and validation scenes (lazily, from the seed), embed e
 (cached under ``--cache``, so a second run embeds nothing), train with Adam (lr 0.001) on the
 class-balanced training pairs, validate on every validation pair each epoch, keep the best epoch.
 Writes the weights (with their metadata header), a ``.json`` provenance file beside them and a
-loss-curve PNG. Uses CUDA when available (``--device``).
+loss-curve PNG. Uses CUDA when available (``--device``). ``--source`` trains on a public data set
+instead (nuScenes or MOTFront, read by :mod:`merlin2_sailor.training.external_source`); its
+scenes are split by scene and the scene counts are capped at what each split holds.
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ from dataclasses import asdict
 from pathlib import Path
 
 DEFAULT_OUTPUT = "matching_network.pt"
+SOURCE_HELP = ("pairs from: generated (default), nuscenes:DATAROOT[:VERSION] (nuScenes' JSON tables, "
+               "e.g. nuscenes:/data/nuscenes:v1.0-mini) or motfront:ROOT")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -25,6 +29,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--output", default=DEFAULT_OUTPUT, metavar="PATH",
                         help=f"weights file to write (default {DEFAULT_OUTPUT}); PATH.json and PATH_loss.png beside it")
+    parser.add_argument("--source", default="generated", metavar="SPEC", help=SOURCE_HELP)
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated source and of training (default 0)")
     parser.add_argument("--train-scenes", type=int, default=120, metavar="N", help="training scenes (default 120)")
     parser.add_argument("--validation-scenes", type=int, default=16, metavar="N",
@@ -56,8 +61,9 @@ def run(arguments: argparse.Namespace) -> int:
     from merlin2_sailor.training.trainer import Trainer, TrainingConfig
 
     started = time.perf_counter()
-    source = generated_source(arguments)
-    sizes = SplitSizes(train=arguments.train_scenes, validation=arguments.validation_scenes, test=0)
+    source = pair_source(arguments)
+    sizes = SplitSizes(train=scene_count(source, TRAIN, arguments.train_scenes),
+                       validation=scene_count(source, VALIDATION, arguments.validation_scenes), test=0)
     balance = None if arguments.balance < 0 else arguments.balance
     train_pairs = PairDatasetConfig(different_class_per_positive=balance, seed=arguments.seed)
     validation_pairs = PairDatasetConfig(seed=arguments.seed)
@@ -74,7 +80,7 @@ def run(arguments: argparse.Namespace) -> int:
 
     output = Path(arguments.output)
     provenance = {
-        "source": "generated",
+        "source": arguments.source,
         "source_fingerprint": source.fingerprint,
         "source_config": asdict(source.config),
         "dataset_hash": dataset_hash(source.fingerprint, sizes.as_dict(), train_pairs),
@@ -110,6 +116,20 @@ def generated_source(arguments: argparse.Namespace):  # type: ignore[no-untyped-
 
     return GeneratedSource(GeneratedSourceConfig(
         seed=arguments.seed, use_darknet=not arguments.no_darknet, darknet_folder=arguments.darknet))
+
+
+def pair_source(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
+    """The source ``--source`` names: the generated one, or a public data set's adapter."""
+    if arguments.source == "generated":
+        return generated_source(arguments)
+    from merlin2_sailor.training.external_source import open_source
+
+    return open_source(arguments.source)
+
+
+def scene_count(source, split: str, requested: int) -> int:  # type: ignore[no-untyped-def]
+    """``requested``, or fewer when a public data set's split holds fewer scenes."""
+    return min(requested, source.split_size(split)) if hasattr(source, "split_size") else requested
 
 
 def embedding_cache(arguments: argparse.Namespace, backbone: str):  # type: ignore[no-untyped-def]
