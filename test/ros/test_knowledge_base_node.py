@@ -32,6 +32,15 @@ def test_a_client_hears_other_writers_and_refusals_leave_the_node_running(node_p
     try:
         heard: list = []
         listener.subscribe(heard.append)
+        # The change topic is volatile, like any event stream: wait until the listener's
+        # subscription and the node's publisher have found each other before writing.
+        topic = f"{namespace}/knowledge_changes"
+        deadline = time.monotonic() + 20.0
+        while time.monotonic() < deadline and not (
+            listener._node.count_publishers(topic) and writer._node.count_subscribers(topic)  # noqa: SLF001
+        ):
+            time.sleep(0.05)
+        time.sleep(0.5)
         writer.apply(DECLARATIONS)
         writer.apply([Change.save(PddlObject("cup_1", "cup")),
                       Change.save(Proposition("seen", ("cup_1",), provenance=Provenance.PERCEIVED))])
