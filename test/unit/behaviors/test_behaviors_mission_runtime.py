@@ -8,7 +8,6 @@ condition, so that a retracted corridor changes which plans exist.
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Callable, Iterator
 
 import pytest
@@ -40,16 +39,14 @@ from merlin2_sailor_behaviors.planning import (  # noqa: E402
 )
 from merlin2_sailor_behaviors.state_machines import (  # noqa: E402
     ABORT,
-    CANCEL,
     SUCCEED,
     Blackboard,
-    State,
     StateMachine,
 )
+from .waiting_state import WAIT_SECONDS, WaitForCancel
 
 WAYPOINTS = ("a", "b", "c", "d")
 CORRIDORS = (("a", "b"), ("a", "c"), ("b", "d"), ("c", "d"), ("b", "c"), ("c", "b"))
-WAIT_SECONDS = 5.0
 
 
 def navigation() -> PddlAction:
@@ -268,23 +265,10 @@ def test_mission_keeps_anchored_objects_and_expects_effects_on_them(
     assert not [p for p in store.propositions.get_all() if p.is_goal]
 
 
-class WaitUntilCancelled(State):
-    def __init__(self) -> None:
-        super().__init__([SUCCEED, CANCEL])
-        self.started = threading.Event()
-
-    def execute(self, blackboard: Blackboard) -> str:
-        self.started.set()
-        deadline = time.monotonic() + WAIT_SECONDS
-        while not self.is_canceled() and time.monotonic() < deadline:
-            time.sleep(0.002)
-        return CANCEL if self.is_canceled() else SUCCEED
-
-
 def test_cancelling_a_mission_cancels_the_running_state_machine(
     store: KnowledgeBase, planner: Planner
 ) -> None:
-    waiting = WaitUntilCancelled()
+    waiting = WaitForCancel()
     machine = StateMachine([SUCCEED, ABORT])
     machine.add_state("drive", waiting)
     mission_runner = runner(store, planner, machine)

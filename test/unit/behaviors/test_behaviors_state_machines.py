@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import threading
-import time
 
 import pytest
 
@@ -13,23 +12,8 @@ from merlin2_sailor_behaviors.state_machines.errors import StateMachineError
 from merlin2_sailor_behaviors.state_machines.outcomes import ABORT, CANCEL, SUCCEED
 from merlin2_sailor_behaviors.state_machines.state import CbState, State
 from merlin2_sailor_behaviors.state_machines.state_machine import StateMachine
+from .waiting_state import WAIT_SECONDS, WaitForCancel
 
-WAIT_SECONDS = 5.0
-
-
-class WaitForCancel(State):
-    """Runs until cancelled, telling the test when it has started."""
-
-    def __init__(self) -> None:
-        super().__init__([SUCCEED, CANCEL])
-        self.started = threading.Event()
-
-    def execute(self, blackboard: Blackboard) -> str:
-        self.started.set()
-        deadline = time.monotonic() + WAIT_SECONDS
-        while not self.is_canceled() and time.monotonic() < deadline:
-            time.sleep(0.002)
-        return CANCEL if self.is_canceled() else SUCCEED
 
 
 def record(name: str, outcome: str = SUCCEED) -> CbState:
