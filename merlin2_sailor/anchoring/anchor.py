@@ -12,7 +12,6 @@ callers read them. Fusion rules live in :mod:`.fusion`, lifecycle rules in :mod:
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass, field
 from enum import Enum
 

@@ -26,6 +26,7 @@ import numpy as np
 
 from merlin2_sailor.errors import ConfigurationError
 
+
 @dataclass(frozen=True, slots=True)
 class FusionConfig:
     """``measurement_variance`` (m^2): a percept position's noise (0.01 = 10 cm standard deviation).

@@ -30,6 +30,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     import rclpy
+
     from merlin2_sailor_interfaces.srv import GetAnchors
 
     rclpy.init()
@@ -57,7 +58,8 @@ def run(arguments: argparse.Namespace) -> int:
 
 
 def render_table(response: Any) -> str:
-    header = f"{'symbol':<18} {'class':<14} {'state':<10} {'x':>7} {'y':>7} {'z':>6} {'conf':>5} {'seen':>5} {'last seen':>12}"
+    header = (f"{'symbol':<18} {'class':<14} {'state':<10} {'x':>7} {'y':>7} {'z':>6} {'conf':>5} "
+              f"{'seen':>5} {'last seen':>12}")
     lines = [f"{len(response.anchors)} anchors in frame '{response.frame_id}'", header, "-" * len(header)]
     for anchor in response.anchors:
         state = STATE_NAMES[anchor.state] if anchor.state < len(STATE_NAMES) else str(anchor.state)

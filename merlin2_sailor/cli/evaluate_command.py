@@ -85,7 +85,9 @@ def run(arguments: argparse.Namespace) -> int:
 
     identities = {}
     if not arguments.no_identity:
-        identities = {name: evaluate_identities(factory, pair_set.scenes(), cache) for name, factory in matchers.items()}
+        identities = {
+            name: evaluate_identities(factory, pair_set.scenes(), cache) for name, factory in matchers.items()
+        }
         print("anchoring (the whole layer replayed over each scene; percepts vs ground-truth instances)")
         print(format_identity_table(identities))
     seconds = time.perf_counter() - started

@@ -36,7 +36,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="validation scenes (default 16)")
     parser.add_argument("--epochs", type=int, default=8, help="epochs (default 8)")
     parser.add_argument("--batch-size", type=int, default=256, help="pairs per batch (default 256)")
-    parser.add_argument("--learning-rate", type=float, default=0.001, help="Adam learning rate (default 0.001, the paper's)")
+    parser.add_argument("--learning-rate", type=float, default=0.001,
+                        help="Adam learning rate (default 0.001, the paper's)")
     parser.add_argument("--balance", type=float, default=2.0, metavar="RATIO",
                         help="different-class pairs kept per positive pair in training; a negative value keeps "
                              "every pair (default 2)")

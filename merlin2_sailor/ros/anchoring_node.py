@@ -21,8 +21,6 @@ from typing import Any
 
 import numpy as np
 from geometry_msgs.msg import PoseStamped
-from merlin2_sailor_interfaces import srv
-from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
@@ -40,7 +38,6 @@ from merlin2_sailor.anchoring.symbols import SymbolCounter
 from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.errors import ConfigurationError, SailorError
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
-from merlin2_sailor.knowledge.store import KnowledgeBase
 from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
 from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.pose import Pose
@@ -58,6 +55,8 @@ from merlin2_sailor.ros.conversions.anchoring import anchor_markers, anchors_to_
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
 
 NODE_NAME = "anchoring"
 

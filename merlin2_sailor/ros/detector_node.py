@@ -23,7 +23,6 @@ import traceback
 from collections.abc import Sequence
 from typing import Any
 
-from merlin2_sailor_interfaces.msg import DetectionArray
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
@@ -39,6 +38,7 @@ from merlin2_sailor.ros.conversions import (
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import SENSOR_DATA
+from merlin2_sailor_interfaces.msg import DetectionArray
 
 NODE_NAME = "detector"
 EXTERNAL_BACKEND = "external"

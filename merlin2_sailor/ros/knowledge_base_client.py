@@ -17,8 +17,6 @@ from collections.abc import Hashable, Iterable, Sequence
 from typing import Any
 
 import rclpy
-from merlin2_sailor_interfaces import srv
-from merlin2_sailor_interfaces.msg import KnowledgeChanges
 from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
@@ -29,6 +27,8 @@ from merlin2_sailor.knowledge.store import KnowledgeBase, Subscriber, Unsubscrib
 from merlin2_sailor.ros.conversions import knowledge as convert
 from merlin2_sailor.ros.knowledge_base_node import CHANGES_TOPIC, KIND_SERVICES
 from merlin2_sailor.ros.qos import EVENTS
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import KnowledgeChanges
 
 DEFAULT_NAMESPACE = "/merlin2"
 
@@ -189,7 +189,7 @@ class RemoteKnowledgeBase(KnowledgeBase):
         for _attempt in range(2):
             done = threading.Event()
             future = client.call_async(request)
-            future.add_done_callback(lambda _future: done.set())
+            future.add_done_callback(lambda _future, finished=done: finished.set())
             if done.wait(self._timeout):
                 return future.result()
             client.remove_pending_request(future)

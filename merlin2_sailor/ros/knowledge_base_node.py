@@ -18,8 +18,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from merlin2_sailor_interfaces import srv
-from merlin2_sailor_interfaces.msg import KnowledgeChanges
 from rclpy.node import Node
 from std_msgs.msg import Header
 
@@ -33,6 +31,8 @@ from merlin2_sailor.ros.conversions import knowledge as convert
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import KnowledgeChanges
 
 NODE_NAME = "knowledge_base"
 CHANGES_TOPIC = "knowledge_changes"

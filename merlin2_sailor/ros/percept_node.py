@@ -35,7 +35,6 @@ from typing import Any
 import numpy as np
 from builtin_interfaces.msg import Time as TimeMessage
 from geometry_msgs.msg import PoseStamped
-from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.time import Time
@@ -69,6 +68,7 @@ from merlin2_sailor.ros.conversions import (
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import SENSOR_DATA
+from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray
 
 NODE_NAME = "percept_generator"
 WARNING_PERIOD_SECONDS = 5.0  # bad input is logged at most this often, whatever the camera rate

@@ -39,7 +39,9 @@ GENERATOR_VERSION = 1
 def _range(name: str, values: tuple[float, float], minimum: float = 0.0) -> None:
     low, high = values
     if not (math.isfinite(low) and math.isfinite(high) and minimum <= low <= high):
-        raise ConfigurationError(f"scene {name} must be a range (low, high) with {minimum} <= low <= high, got {values}.")
+        raise ConfigurationError(
+            f"scene {name} must be a range (low, high) with {minimum} <= low <= high, got {values}."
+        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,7 +80,9 @@ class SceneConfig:
     def __post_init__(self) -> None:
         _range("objects", self.objects, 1)
         if self.samples < 2:
-            raise ConfigurationError(f"scene samples must be at least 2 (pairs need an earlier sample), got {self.samples}.")
+            raise ConfigurationError(
+                f"scene samples must be at least 2 (pairs need an earlier sample), got {self.samples}."
+            )
         if not (math.isfinite(self.room_size) and self.room_size > 2.0):
             raise ConfigurationError(f"scene room_size must be more than 2 m, got {self.room_size}.")
         if self.classes_per_scene < 1:

@@ -125,7 +125,10 @@ def evaluate_identities(
 
 def format_identity_table(rows: dict[str, IdentityMetrics]) -> str:
     width = max([len(name) for name in rows] + [8])
-    lines = [f"{'':<{width}}  {'percepts':>8} {'objects':>8} {'anchors':>8} {'ID sw.':>7} {'IDF1':>7} {'IDP':>7} {'IDR':>7} {'MOTA':>7}"]
+    lines = [
+        f"{'':<{width}}  {'percepts':>8} {'objects':>8} {'anchors':>8} {'ID sw.':>7} "
+        f"{'IDF1':>7} {'IDP':>7} {'IDR':>7} {'MOTA':>7}"
+    ]
     for name, m in rows.items():
         lines.append(
             f"{name:<{width}}  {m.percepts:>8d} {m.instances:>8d} {m.anchors:>8d} {m.id_switches:>7d} "

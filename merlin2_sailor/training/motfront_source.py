@@ -154,7 +154,9 @@ class MotFrontSource(ImageSource):
             raise InvalidInputError(f"MOTFront {where} lacks bbox, 3Dbbox, category_id or "
                                     f"{self.config.identity_key!r}: {error!r}") from error
         if corners.shape != (8, 3) or not np.all(np.isfinite(corners)):
-            raise InvalidInputError(f"MOTFront {where}: 3Dbbox must be 8 finite (x, y, z) corners, got {corners.shape}.")
+            raise InvalidInputError(
+                f"MOTFront {where}: 3Dbbox must be 8 finite (x, y, z) corners, got {corners.shape}."
+            )
         box = clip_box(x, y, x + width, y + height, int(image["width"]), int(image["height"]),
                        self.config.min_crop_pixels)
         if box is None:

@@ -54,7 +54,9 @@ class PairDatasetConfig:
         if ratio is not None and not (math.isfinite(ratio) and ratio >= 0.0):
             raise ConfigurationError(f"different_class_per_positive must be None or >= 0, got {ratio}.")
         if not (math.isfinite(self.look_alike_distance) and self.look_alike_distance > 0.0):
-            raise ConfigurationError(f"look_alike_distance must be a positive distance, got {self.look_alike_distance}.")
+            raise ConfigurationError(
+                f"look_alike_distance must be a positive distance, got {self.look_alike_distance}."
+            )
 
 
 @dataclass(frozen=True, slots=True, eq=False)

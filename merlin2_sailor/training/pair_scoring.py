@@ -10,8 +10,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from merlin2_sailor.anchoring.features import PairFeatures
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.errors import ConfigurationError

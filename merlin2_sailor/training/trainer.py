@@ -52,7 +52,9 @@ class TrainingConfig:
         if self.device not in ("auto", "cpu", "cuda"):
             raise ConfigurationError(f"training device must be auto, cpu or cuda, got {self.device!r}.")
         if self.device == "cuda" and not torch.cuda.is_available():
-            raise ConfigurationError("training device cuda was asked for but torch sees no CUDA device; use auto or cpu.")
+            raise ConfigurationError(
+                "training device cuda was asked for but torch sees no CUDA device; use auto or cpu."
+            )
         if not (0.0 < self.threshold < 1.0):
             raise ConfigurationError(f"training threshold must be in (0, 1), got {self.threshold}.")
 

@@ -17,8 +17,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
-from merlin2_sailor_interfaces import srv
-from merlin2_sailor_interfaces.msg import Anchor, AnchorArray, AnchorEvent, AnchorEventArray, PerceptArray
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import CameraInfo
 from std_msgs.msg import Header
@@ -28,6 +26,8 @@ from merlin2_sailor.knowledge import open_store
 from merlin2_sailor.ros.conversions import camera_info_message, percepts_to_message, seconds_to_stamp
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
 from merlin2_sailor_demos.rgbd_player_node import DEFAULT_CAMERA_POSE
+from merlin2_sailor_interfaces import srv
+from merlin2_sailor_interfaces.msg import Anchor, AnchorArray, AnchorEvent, AnchorEventArray, PerceptArray
 
 pytestmark = pytest.mark.ros
 

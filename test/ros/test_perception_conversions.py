@@ -7,8 +7,6 @@ import math
 import numpy as np
 import pytest
 from geometry_msgs.msg import TransformStamped
-from merlin2_sailor_interfaces.msg import Detection as DetectionMessage
-from merlin2_sailor_interfaces.msg import DetectionArray, Mask, Point2D, PerceptArray
 from nav_msgs.msg import Odometry
 from scipy.spatial.transform import Rotation
 from sensor_msgs.msg import CameraInfo, PointField
@@ -40,6 +38,8 @@ from merlin2_sailor.ros.conversions import (
     seconds_to_stamp,
     transform_to_pose,
 )
+from merlin2_sailor_interfaces.msg import Detection as DetectionMessage
+from merlin2_sailor_interfaces.msg import DetectionArray, Mask, PerceptArray, Point2D
 
 
 def make_percept(crop_shape: tuple[int, int] = (4, 6), **changes: object) -> Percept:

@@ -20,7 +20,6 @@ from typing import Any
 import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
-from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray
 from nav_msgs.msg import Odometry
 from scipy.spatial.transform import Rotation
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
@@ -44,6 +43,7 @@ from merlin2_sailor.ros.conversions import (
 from merlin2_sailor.ros.detector_node import NewestFrameMailbox
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_demos.rgbd_sources import load_source
+from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray
 
 pytestmark = pytest.mark.ros
 

@@ -6,15 +6,15 @@ from collections.abc import Sequence
 from types import MappingProxyType
 
 from diagnostic_msgs.msg import KeyValue
-from merlin2_sailor_interfaces.msg import Anchor as AnchorMessage
-from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray
-from merlin2_sailor_interfaces.msg import AnchorEvent as AnchorEventMessage
 from std_msgs.msg import Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.ros.conversions.sensors import seconds_to_stamp
+from merlin2_sailor_interfaces.msg import Anchor as AnchorMessage
+from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray
+from merlin2_sailor_interfaces.msg import AnchorEvent as AnchorEventMessage
 
 STATE_TO_MESSAGE = MappingProxyType({
     AnchorState.TENTATIVE: AnchorMessage.STATE_TENTATIVE,

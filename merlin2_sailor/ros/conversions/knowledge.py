@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from types import MappingProxyType
 
+from merlin2_sailor.errors import KnowledgeError
+from merlin2_sailor.knowledge import model
+from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind, Operation, kind_of
 from merlin2_sailor_interfaces.msg import (
     KnowledgeChange,
     PddlAction,
@@ -20,10 +23,6 @@ from merlin2_sailor_interfaces.msg import (
     PddlProposition,
     PddlType,
 )
-
-from merlin2_sailor.errors import KnowledgeError
-from merlin2_sailor.knowledge import model
-from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind, Operation, kind_of
 
 _PROVENANCE_TO_MESSAGE = MappingProxyType({
     model.Provenance.PERCEIVED: PddlProposition.PROVENANCE_PERCEIVED,

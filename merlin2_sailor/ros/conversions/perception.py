@@ -17,9 +17,6 @@ from collections.abc import Sequence
 import numpy as np
 from geometry_msgs.msg import Point, Quaternion, TransformStamped, Vector3
 from geometry_msgs.msg import Pose as PoseMessage
-from merlin2_sailor_interfaces.msg import Detection as DetectionMessage
-from merlin2_sailor_interfaces.msg import DetectionArray, Mask, Point2D, PerceptArray
-from merlin2_sailor_interfaces.msg import Percept as PerceptMessage
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 from std_msgs.msg import ColorRGBA, Header
@@ -31,6 +28,9 @@ from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.ros.conversions.sensors import array_to_image, image_to_array, seconds_to_stamp, stamp_to_seconds
+from merlin2_sailor_interfaces.msg import Detection as DetectionMessage
+from merlin2_sailor_interfaces.msg import DetectionArray, Mask, PerceptArray, Point2D
+from merlin2_sailor_interfaces.msg import Percept as PerceptMessage
 
 #: Colour encodings a detector can take, and how to reorder their channels into RGB.
 _TO_RGB_CHANNELS = {"rgb8": (0, 1, 2), "rgba8": (0, 1, 2), "bgr8": (2, 1, 0), "bgra8": (2, 1, 0)}

@@ -58,7 +58,7 @@ def test_architecture_has_the_published_sizes():
     assert network.siamese_branch[0].in_features == 512 and network.siamese_branch[0].out_features == 256
     assert network.merge[0].in_features == 1280 and network.merge[0].out_features == 256
     layers = [m for m in network.classifier if isinstance(m, torch.nn.Linear)]
-    assert [(l.in_features, l.out_features) for l in layers] == [(256, 1024), (1024, 256), (256, 1)]
+    assert [(layer.in_features, layer.out_features) for layer in layers] == [(256, 1024), (1024, 256), (256, 1)]
     assert isinstance(network.classifier[0], torch.nn.Dropout) and network.classifier[0].p == 0.5
     assert MatchingNetwork(NetworkMetadata(backbone="resnet18", feature_dimension=512)).siamese[0].in_features == 512
 

@@ -43,6 +43,7 @@ from merlin2_sailor_behaviors.state_machines import (  # noqa: E402
     Blackboard,
     StateMachine,
 )
+
 from .waiting_state import WAIT_SECONDS, WaitForCancel
 
 WAYPOINTS = ("a", "b", "c", "d")

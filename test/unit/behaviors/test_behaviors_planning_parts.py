@@ -19,9 +19,9 @@ from merlin2_sailor.knowledge import (
 )
 from merlin2_sailor_behaviors.planning import (
     EffectWriter,
-    PlanStep,
     Planner,
     PlannerConfig,
+    PlanStep,
     anchored_by_provenance,
     task_from_store,
 )

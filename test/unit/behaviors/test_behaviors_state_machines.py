@@ -12,8 +12,8 @@ from merlin2_sailor_behaviors.state_machines.errors import StateMachineError
 from merlin2_sailor_behaviors.state_machines.outcomes import ABORT, CANCEL, SUCCEED
 from merlin2_sailor_behaviors.state_machines.state import CbState, State
 from merlin2_sailor_behaviors.state_machines.state_machine import StateMachine
-from .waiting_state import WAIT_SECONDS, WaitForCancel
 
+from .waiting_state import WAIT_SECONDS, WaitForCancel
 
 
 def record(name: str, outcome: str = SUCCEED) -> CbState:

@@ -8,8 +8,8 @@ import importlib.util
 import socket
 import subprocess
 import sys
-import time
 import threading
+import time
 import uuid
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field

@@ -38,7 +38,9 @@ def colour_embedder() -> ColourEmbedder:
     return ColourEmbedder()
 
 
-def observation(instance: int, sample: int, class_name: str = "cup", position=(0.0, 0.0, 0.0), stamp=None) -> Observation:
+def observation(
+    instance: int, sample: int, class_name: str = "cup", position=(0.0, 0.0, 0.0), stamp=None
+) -> Observation:
     """A hand-made observation (region and view are placeholders: never rendered)."""
     return Observation(
         crop_id=f"hand/{sample}/{instance}",

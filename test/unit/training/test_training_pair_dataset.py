@@ -50,7 +50,11 @@ def test_an_object_unseen_for_a_while_is_paired_with_its_last_sighting() -> None
 
 def test_look_alike_flags_same_class_pairs_that_are_near() -> None:
     scene = hand_scene([
-        [observation(0, 0, "cup", (0, 0, 0)), observation(1, 0, "cup", (3, 0, 0)), observation(2, 0, "cat", (0.1, 0, 0))],
+        [
+            observation(0, 0, "cup", (0, 0, 0)),
+            observation(1, 0, "cup", (3, 0, 0)),
+            observation(2, 0, "cat", (0.1, 0, 0)),
+        ],
         [observation(0, 1, "cup", (0.05, 0, 0))],
     ])
     chunk = scene_pairs(scene, PairDatasetConfig(look_alike_distance=1.0))
