@@ -39,8 +39,9 @@ from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import SNAPSHOT_FORMAT, SNAPSHOT_VERSION, anchor_from_dict, anchor_to_dict
 from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
 from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig, should_be_visible
-from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
+from merlin2_sailor.errors import ConfigurationError, InvalidInputError, KnowledgeError, SailorError
 from merlin2_sailor.knowledge.model import Provenance
+from merlin2_sailor.knowledge.naming import to_identifier
 from merlin2_sailor.perception.pose import Pose
 
 #: find() prefers anchors in this order of state.
@@ -487,6 +488,12 @@ class Anchoring:
                 )
             if not math.isfinite(percept.stamp):
                 raise InvalidInputError(f"Percept {number} has a non-finite stamp {percept.stamp}.")
+            try:  # checked here, before anything changes, not when a symbol is made mid-frame
+                to_identifier(percept.class_name)
+            except KnowledgeError as error:
+                raise InvalidInputError(
+                    f"Percept {number} has a class name {percept.class_name!r} no symbol can be made from: {error}"
+                ) from error
 
 
 def _point(values: Any, name: str) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -299,3 +300,14 @@ def test_twin_mugs_scene_is_in_view(twin_mugs):
     positions = np.array([item.position for item in TWIN_MUGS])
     sizes = np.array([item.size for item in TWIN_MUGS])
     assert should_be_visible(positions, sizes, camera_view(), VisibilityConfig()).all()
+
+
+@pytest.mark.parametrize("class_name", ["", "???", "  "])
+def test_a_frame_with_an_unnameable_class_is_refused_whole_before_any_change(make_anchoring, maker, class_name):
+    anchoring = make_anchoring()
+    anchoring.process([maker.percept(item, 0.0) for item in KITCHEN], camera_view(), 0.0)
+    before = {anchor.symbol: anchor.times_seen for anchor in anchoring.anchors}
+    bad = dataclasses.replace(maker.percept(KITCHEN[0], FRAME), class_name=class_name)
+    with pytest.raises(InvalidInputError, match="class name"):
+        anchoring.process([maker.percept(KITCHEN[1], FRAME), bad], camera_view(), FRAME)
+    assert {anchor.symbol: anchor.times_seen for anchor in anchoring.anchors} == before
