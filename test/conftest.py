@@ -13,7 +13,6 @@ import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -48,24 +47,12 @@ class RosProbe:
 
     def __init__(self) -> None:
         import rclpy
-        from rclpy.executors import SingleThreadedExecutor
 
-        self._rclpy = rclpy
-        self.context = rclpy.Context()
-        rclpy.init(context=self.context)
-        self.node = rclpy.create_node(f"test_probe_{os.getpid()}", context=self.context)
-        self._executor = SingleThreadedExecutor(context=self.context)
-        self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
+        from merlin2_sailor.ros.background_spinner import BackgroundSpinner
 
-    def _spin(self) -> None:
-        from rclpy.executors import ExternalShutdownException
-
-        try:
-            self._executor.spin()
-        except ExternalShutdownException:
-            pass
+        self._spinner = BackgroundSpinner("test-probe")
+        self.context = self._spinner.context
+        self.node = self._spinner.add_node(rclpy.create_node(f"test_probe_{os.getpid()}", context=self.context))
 
     def node_names(self) -> set[str]:
         """Fully qualified names of the nodes currently in the graph."""
@@ -97,10 +84,7 @@ class RosProbe:
         return received[:count]
 
     def close(self) -> None:
-        self._executor.shutdown()
-        self._rclpy.try_shutdown(context=self.context)
-        self._thread.join(timeout=5.0)
-        self.node.destroy_node()
+        self._spinner.close()
 
 
 @pytest.fixture

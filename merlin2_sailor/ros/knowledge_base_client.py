@@ -18,12 +18,12 @@ from typing import Any
 
 import rclpy
 from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
 from merlin2_sailor.errors import KnowledgeError
 from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind
 from merlin2_sailor.knowledge.model import KnowledgeItem, Proposition
 from merlin2_sailor.knowledge.store import KnowledgeBase, Subscriber, Unsubscribe
+from merlin2_sailor.ros.background_spinner import BackgroundSpinner
 from merlin2_sailor.ros.conversions import knowledge as convert
 from merlin2_sailor.ros.knowledge_base_node import CHANGES_TOPIC, KIND_SERVICES
 from merlin2_sailor.ros.qos import EVENTS
@@ -42,18 +42,15 @@ class RemoteKnowledgeBase(KnowledgeBase):
         self._timeout = timeout
         self._writer = f"client_{uuid.uuid4().hex}"
         self._kinds = {services.kind: services for services in KIND_SERVICES}
-        self._context = rclpy.Context()
-        rclpy.init(context=self._context)
-        self._node = rclpy.create_node(f"knowledge_base_{self._writer}", context=self._context)
-        self._executor = SingleThreadedExecutor(context=self._context)
-        self._executor.add_node(self._node)
+        self._spinner = BackgroundSpinner("knowledge-base-client")
+        self._context = self._spinner.context
+        self._node = self._spinner.add_node(
+            rclpy.create_node(f"knowledge_base_{self._writer}", context=self._context))
         self._clients: dict[str, Any] = {}
         self._clients_lock = threading.Lock()
         self._subscribers: list[Subscriber] = []
         self._subscription: Any = None
         self._closed = False
-        self._spinner = threading.Thread(target=self._spin, name="knowledge-base-client", daemon=True)
-        self._spinner.start()
 
     # Reads.
 
@@ -115,18 +112,9 @@ class RemoteKnowledgeBase(KnowledgeBase):
         if self._closed:
             return
         self._closed = True
-        self._executor.shutdown()
-        rclpy.try_shutdown(context=self._context)
-        self._spinner.join(timeout=5.0)
-        self._node.destroy_node()
+        self._spinner.close()
 
     # Internals.
-
-    def _spin(self) -> None:
-        try:
-            self._executor.spin()
-        except ExternalShutdownException:
-            pass
 
     def _on_changes(self, message: KnowledgeChanges) -> None:
         if message.writer == self._writer or not message.changes:

@@ -8,7 +8,6 @@ import importlib.util
 import socket
 import subprocess
 import sys
-import threading
 import time
 import uuid
 from collections.abc import Callable, Iterator
@@ -101,35 +100,18 @@ def knowledge_base_node(tmp_path: Path) -> Iterator[str]:
     """A knowledge_base node over a SQLite store, spinning in this process in a ROS context of
     its own, under a namespace of this test's own; yields its ``ros://`` location. The client
     that the test opens there talks to it over DDS like any other process would."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
-
+    from merlin2_sailor.ros.background_spinner import BackgroundSpinner
     from merlin2_sailor.ros.knowledge_base_node import KnowledgeBaseNode
 
     namespace = f"/kb_{uuid.uuid4().hex[:12]}"
-    context = rclpy.Context()
-    rclpy.init(context=context)
-    node = KnowledgeBaseNode(
-        store=open_store(f"sqlite://{tmp_path / 'served.db'}"), context=context, namespace=namespace
-    )
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-
-    def spin() -> None:
-        try:
-            executor.spin()
-        except ExternalShutdownException:
-            pass
-
-    spinner = threading.Thread(target=spin, daemon=True)
-    spinner.start()
+    spinner = BackgroundSpinner("knowledge-base-node")
+    spinner.add_node(KnowledgeBaseNode(
+        store=open_store(f"sqlite://{tmp_path / 'served.db'}"), context=spinner.context, namespace=namespace
+    ))
     try:
         yield f"ros://{namespace}"
     finally:
-        executor.shutdown()
-        rclpy.try_shutdown(context=context)
-        spinner.join(timeout=5.0)
-        node.destroy_node()
+        spinner.close()
 
 
 @pytest.fixture(params=["memory", "sqlite", "mongo", pytest.param("ros", marks=pytest.mark.ros)])
