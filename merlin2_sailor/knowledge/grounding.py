@@ -64,6 +64,8 @@ class Waypoint:
     name: str
     x: float
     y: float
+    yaw: float | None = None
+    """Heading (radians, world frame) a robot should face on arrival; None when any will do."""
 
 
 @dataclass(frozen=True)
@@ -118,6 +120,10 @@ class GroundingConfig:
     at_predicate: str = "object_at"
     seen_predicate: str = "seen"
     visible_predicate: str = "visible"
+    missing_predicate: str = "missing"
+    """Written for an anchor in state MISSING, which then has no ``at`` fact: the camera saw its
+    place without it, so the planner must not rely on the old location, and a search action can
+    take ``missing(?o)`` as its condition."""
     ungrounded_states: frozenset[str] = frozenset({"tentative", "forgotten"})
     """Anchor states that have no symbol in the knowledge base (yet, or any more)."""
     size_categories: tuple[SizeCategory, ...] = ()
@@ -148,12 +154,16 @@ class GroundingConfig:
             "at_predicate",
             "seen_predicate",
             "visible_predicate",
+            "missing_predicate",
         ):
             setting(attribute, name(getattr(self, attribute)))
         setting("ungrounded_states", frozenset(str(s).lower() for s in self.ungrounded_states))
         setting(
             "waypoints",
-            tuple(Waypoint(name(w.name), float(w.x), float(w.y)) for w in self.waypoints),
+            tuple(
+                Waypoint(name(w.name), float(w.x), float(w.y), None if w.yaw is None else float(w.yaw))
+                for w in self.waypoints
+            ),
         )
         setting(
             "regions",
@@ -188,10 +198,10 @@ class GroundingConfig:
         supertypes: {cup: container, glass: container}
         location_type: wp
         map:
-          waypoints: [{name: kitchen, x: 1.0, y: 2.0}]  # or {kitchen: [1.0, 2.0]}
+          waypoints: [{name: kitchen, x: 1.0, y: 2.0, yaw: 1.57}]  # or {kitchen: [1.0, 2.0]}; yaw optional
           regions: [{name: living_room, x_min: 0, y_min: 0, x_max: 5, y_max: 4}]
         max_waypoint_distance: 1.0
-        predicates: {at: object_at, seen: seen, visible: visible}
+        predicates: {at: object_at, seen: seen, visible: visible, missing: missing}
         ungrounded_states: [tentative, forgotten]
         size_categories: {small: 0.3, medium: 1.0}
         """
@@ -216,7 +226,7 @@ class GroundingConfig:
                 options["max_waypoint_distance"] = float(data["max_waypoint_distance"])
             if "ungrounded_states" in data:
                 options["ungrounded_states"] = frozenset(data["ungrounded_states"])
-            for role in ("at", "seen", "visible"):
+            for role in ("at", "seen", "visible", "missing"):
                 if role in predicates:
                     options[f"{role}_predicate"] = predicates[role]
             options["waypoints"] = _waypoints(map_data.get("waypoints") or [])
@@ -256,20 +266,29 @@ class GroundingConfig:
 
 
 def _waypoints(data: Any) -> tuple[Waypoint, ...]:
+    """``{kitchen: [x, y]}`` or ``{kitchen: [x, y, yaw]}``, or a list of ``{name, x, y[, yaw]}``."""
     if isinstance(data, Mapping):
         return tuple(
-            Waypoint(name, float(coordinates[0]), float(coordinates[1]))
-            for name, coordinates in data.items()
+            Waypoint(name, float(values[0]), float(values[1]), _optional_float(values[2:3]))
+            for name, values in data.items()
         )
-    return tuple(Waypoint(w["name"], float(w["x"]), float(w["y"])) for w in data)
+    return tuple(
+        Waypoint(w["name"], float(w["x"]), float(w["y"]), _optional_float([w["yaw"]] if "yaw" in w else []))
+        for w in data
+    )
+
+
+def _optional_float(values: Any) -> float | None:
+    return float(values[0]) if len(values) and values[0] is not None else None
 
 
 @dataclass(frozen=True)
 class GroundedAnchor:
     """An anchor as the knowledge base sees it: one object and its perceived facts.
 
-    ``visible`` says whether the facts are fresh evidence from this frame or the last known
-    state of an anchor out of view, which decides what they may overrule.
+    ``visible`` says whether the facts are fresh evidence or the last known state of an anchor
+    out of view, which decides what they may overrule. An anchor in view is fresh evidence, and
+    so is a missing one: the camera has just seen its place without it.
     """
 
     object: PddlObject
@@ -306,6 +325,7 @@ class Grounding:
                 config.at_predicate,
                 config.seen_predicate,
                 config.visible_predicate,
+                config.missing_predicate,
                 *(category.name for category in config.size_categories),
             }
         )
@@ -323,6 +343,7 @@ class Grounding:
             Predicate(config.at_predicate, (ROOT_TYPE, config.location_type)),
             Predicate(config.seen_predicate, (ROOT_TYPE,)),
             Predicate(config.visible_predicate, (ROOT_TYPE,)),
+            Predicate(config.missing_predicate, (ROOT_TYPE,)),
             *(Predicate(category.name, (ROOT_TYPE,)) for category in config.size_categories),
         ]
         locations = [PddlObject(place.name, config.location_type) for place in self._locations]
@@ -365,7 +386,12 @@ class Grounding:
                 facts.append(
                     Proposition(config.visible_predicate, (name,), provenance=Provenance.PERCEIVED)
                 )
-            if location is not None:
+            missing = _state_name(anchor.state) == "missing"
+            if missing:
+                facts.append(
+                    Proposition(config.missing_predicate, (name,), provenance=Provenance.PERCEIVED)
+                )
+            elif location is not None:
                 facts.append(
                     Proposition(
                         config.at_predicate, (name, location), provenance=Provenance.PERCEIVED
@@ -377,7 +403,7 @@ class Grounding:
             result[name] = GroundedAnchor(
                 PddlObject(name, self.type_of(anchor.class_name)),
                 frozenset(facts),
-                bool(anchor.visible),
+                bool(anchor.visible) or missing,
             )
         return result
 

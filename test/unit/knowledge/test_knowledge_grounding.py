@@ -110,6 +110,21 @@ def test_an_anchor_out_of_view_is_seen_but_not_visible(grounding, make_anchor):
     assert not result["cup_1"].visible
 
 
+def test_a_missing_anchor_has_no_location_but_a_missing_fact(grounding, make_anchor):
+    """The camera saw its place without it: the old location must not reach the planner."""
+    result = grounding.ground([make_anchor("cup_1", "cup", 0.1, 0.1, state="missing", visible=False)])
+    assert result["cup_1"].facts == {perceived("seen", "cup_1"), perceived("missing", "cup_1")}
+    assert result["cup_1"].visible  # fresh evidence: it may overrule what an action expected
+
+
+def test_waypoints_may_carry_a_heading():
+    config = GroundingConfig.from_mapping(
+        {"map": {"waypoints": [{"name": "hall", "x": 1, "y": 2, "yaw": 1.5}, {"name": "door", "x": 0, "y": 0}]}}
+    )
+    assert [(w.name, w.yaw) for w in config.waypoints] == [("hall", 1.5), ("door", None)]
+    assert GroundingConfig.from_mapping({"map": {"waypoints": {"hall": [1, 2, -0.5]}}}).waypoints[0].yaw == -0.5
+
+
 def test_anchors_without_a_symbol_state_are_not_grounded(grounding, make_anchor):
     result = grounding.ground(
         [
@@ -148,7 +163,7 @@ def test_declarations_are_accepted_by_a_store_with_the_facts(grounding, make_anc
     assert PddlType("cup", "container") in declarations
     assert Predicate("object_at", ("object", "wp")) in declarations
     assert PddlObject("living_room", "wp") in declarations
-    assert grounding.managed_predicates == {"object_at", "seen", "visible", "small", "large"}
+    assert grounding.managed_predicates == {"object_at", "seen", "visible", "missing", "small", "large"}
     grounded = grounding.ground([make_anchor("cup_1", "cup", 7, 0)])["cup_1"]
     with open_store() as store:
         store.apply(

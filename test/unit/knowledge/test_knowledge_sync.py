@@ -162,6 +162,35 @@ class TestPerceptionOutranksExpectation:
         assert changed_items(events) == {(Operation.DELETE, perceived("visible", "cup_1"))}
         assert expected("object_at", "cup_1", "door") in facts_about(mission_store, "cup_1")
 
+    def test_an_anchor_gone_missing_loses_its_location(self, sync, mission_store, make_anchor):
+        sync.sync([make_anchor("cup_1", "cup", 0.2, 0), make_anchor("cup_2", "cup", 3.0, 0)])
+        # A navigation announced cup_2 at the table (EXPECTED); the camera then saw both places empty.
+        mission_store.apply(
+            [
+                Change.delete(perceived("object_at", "cup_2", "table")),
+                Change.save(expected("object_at", "cup_2", "table")),
+            ]
+        )
+        events = sync.sync(
+            [
+                make_anchor("cup_1", "cup", 0.2, 0, state="missing", visible=False),
+                make_anchor("cup_2", "cup", 3.0, 0, state="missing", visible=False),
+            ]
+        )
+        assert changed_items(events) == {
+            (Operation.DELETE, perceived("object_at", "cup_1", "kitchen")),
+            (Operation.DELETE, perceived("visible", "cup_1")),
+            (Operation.SAVE, perceived("missing", "cup_1")),
+            (Operation.DELETE, expected("object_at", "cup_2", "table")),
+            (Operation.DELETE, perceived("visible", "cup_2")),
+            (Operation.SAVE, perceived("missing", "cup_2")),
+        }
+        # Reacquired elsewhere: the missing fact goes, the new location comes.
+        sync.sync([make_anchor("cup_1", "cup", 6.1, 0)])
+        assert facts_about(mission_store, "cup_1") == {
+            perceived("seen", "cup_1"), perceived("visible", "cup_1"), perceived("object_at", "cup_1", "door")
+        }
+
     def test_declared_facts_are_left_alone(self, sync, mission_store, make_anchor):
         sync.sync([make_anchor("cup_1", "cup", 0.2, 0)])
         mission_store.propositions.save(Proposition("object_at", ("cup_1", "table")))
