@@ -67,6 +67,7 @@ class AnchorIndex:
         self._indexed_positions = np.zeros((0, 3))
         self._last_seen = np.zeros(0)
         self._class_names = np.zeros(0, dtype=object)
+        self._search_radii = np.zeros(0)
         self._alive = np.zeros(0, dtype=bool)
         self._tree: cKDTree | None = None
         self._tree_slots = np.zeros(0, dtype=np.intp)
@@ -141,6 +142,13 @@ class AnchorIndex:
     def class_names_of(self, slots: np.ndarray) -> np.ndarray:
         return self._class_names[slots]
 
+    def search_radii_of(self, slots: np.ndarray) -> np.ndarray:
+        """The search radius of each anchor's expectation (0 where it is not being searched for)."""
+        return self._search_radii[slots]
+
+    def largest_search_radius(self) -> float:
+        return float(np.max(self._search_radii[self._alive], initial=0.0)) if self._slot_of else 0.0
+
     def within(self, points: np.ndarray, radius: float) -> list[np.ndarray]:
         """For each of the (N, 3) points, the slots of anchors within ``radius`` of it (sorted)."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -173,6 +181,7 @@ class AnchorIndex:
         self._positions[slot] = position
         self._last_seen[slot] = anchor.last_seen
         self._class_names[slot] = anchor.class_name
+        self._search_radii[slot] = anchor.expectation.radius if anchor.expectation is not None else 0.0
 
     def _grow(self) -> int:
         """Open a new slot at the end, doubling the arrays' capacity when they are full."""
@@ -183,6 +192,7 @@ class AnchorIndex:
             self._indexed_positions = np.concatenate((self._indexed_positions, np.zeros((extra, 3))))
             self._last_seen = np.concatenate((self._last_seen, np.zeros(extra)))
             self._class_names = np.concatenate((self._class_names, np.zeros(extra, dtype=object)))
+            self._search_radii = np.concatenate((self._search_radii, np.zeros(extra)))
             self._alive = np.concatenate((self._alive, np.zeros(extra, dtype=bool)))
             self._in_tree = np.concatenate((self._in_tree, np.zeros(extra, dtype=bool)))
             self._is_pending = np.concatenate((self._is_pending, np.zeros(extra, dtype=bool)))

@@ -271,11 +271,18 @@ class Anchoring:
             self._move_to_expected(anchor, position)
 
     def clear_expectation(self, symbol: str) -> None:
-        """Drop an expectation that no longer applies (e.g. the carrying action ended)."""
+        """Drop an expectation that no longer applies (the carrying action ended, a search failed).
+
+        An expectation perception never confirmed was only a prediction: the anchor goes back to
+        where it was last perceived.
+        """
         anchor = self._require(symbol)
-        anchor.expectation = None
-        anchor.expectation_confirmed = False
-        self._expected.discard(symbol)
+        if anchor.expectation is None:
+            return
+        if not anchor.expectation_confirmed:
+            anchor.position = anchor.perceived_position.copy()
+        self._drop_expectation(anchor)
+        self._index.refresh(anchor)
 
     # --- forgetting, snapshots --------------------------------------------------------------
 
@@ -377,7 +384,7 @@ class Anchoring:
         assert expectation is not None
         distance = float(np.linalg.norm(np.asarray(percept.position) - anchor.position))
         details = {"expectation": expectation.describe(), "distance": distance}
-        if distance > self.config.expectation_tolerance:
+        if distance > self.config.expectation_tolerance + expectation.radius:
             changes.event(AnchorEventKind.RETRACTED, anchor.symbol, reason="seen elsewhere", **details)
             self._drop_expectation(anchor)
             anchor.position = anchor.perceived_position.copy()
@@ -408,6 +415,8 @@ class Anchoring:
             np.array([a.position for a in anchors]), np.array([a.size for a in anchors]), camera, self.config.visibility
         )
         for anchor in (a for a, expected in zip(anchors, visible, strict=True) if expected):
+            if anchor.expectation is not None and anchor.expectation.is_search:
+                continue  # the searcher decides when a search has failed
             if anchor.expectation is not None:
                 changes.event(
                     AnchorEventKind.RETRACTED,

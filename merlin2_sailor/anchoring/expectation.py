@@ -8,6 +8,7 @@ decide: reacquired near the expected place confirms it, the place seen empty ret
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
@@ -33,6 +34,12 @@ class Expectation:
     ``position`` is the world position for AT and the offset in the robot's frame for CARRIED.
     ``place`` names the waypoint or region when there is one; ``source`` names the action that
     announced it. Both only travel into event details, for whoever has to explain a retraction.
+
+    ``radius`` > 0 makes an AT expectation a search (top-down Find): "it may be somewhere within
+    ``radius`` of ``position``". The matching table then counts a percept anywhere in that disc
+    as close, with a score capped below that of an anchor seen in place, so a look-alike already
+    anchored there keeps its own percept. A search is never retracted by an empty view (the
+    searcher cannot know which part of the disc the camera covered); the searcher clears it.
     """
 
     kind: ExpectationKind
@@ -40,6 +47,7 @@ class Expectation:
     stamp: float
     place: str = ""
     source: str = ""
+    radius: float = 0.0
 
     def __post_init__(self) -> None:
         position = np.array(self.position, dtype=np.float64).reshape(-1)
@@ -48,15 +56,26 @@ class Expectation:
                 f"An expected {self.kind.value} position needs 3 finite values, "
                 f"got {np.asarray(self.position).tolist()}."
             )
+        if not (math.isfinite(self.radius) and self.radius >= 0.0):
+            raise InvalidInputError(f"An expectation's search radius must be >= 0 metres, got {self.radius}.")
+        if self.radius > 0.0 and self.kind is not ExpectationKind.AT:
+            raise InvalidInputError("Only an expectation at a place can be a search with a radius.")
         if not np.isfinite(self.stamp):
             raise InvalidInputError(f"An expectation's stamp must be finite, got {self.stamp}.")
         position.setflags(write=False)
         object.__setattr__(self, "position", position)
 
     @classmethod
-    def at(cls, position: np.ndarray, stamp: float, place: str = "", source: str = "") -> Expectation:
-        """The object is expected at ``position`` (world frame), e.g. a waypoint's coordinates."""
-        return cls(ExpectationKind.AT, np.asarray(position, dtype=np.float64), stamp, place, source)
+    def at(
+        cls, position: np.ndarray, stamp: float, place: str = "", source: str = "", radius: float = 0.0
+    ) -> Expectation:
+        """The object is expected at ``position`` (world frame), or within ``radius`` of it (a search)."""
+        return cls(ExpectationKind.AT, np.asarray(position, dtype=np.float64), stamp, place, source, float(radius))
+
+    @property
+    def is_search(self) -> bool:
+        """Whether this is a top-down search over a disc rather than a predicted place."""
+        return self.radius > 0.0
 
     @classmethod
     def carried(
@@ -81,6 +100,7 @@ class Expectation:
             "stamp": float(self.stamp),
             "place": self.place,
             "source": self.source,
+            "radius": self.radius,
         }
 
     @classmethod
@@ -93,6 +113,7 @@ class Expectation:
                 float(description["stamp"]),
                 str(description.get("place", "")),
                 str(description.get("source", "")),
+                float(description.get("radius", 0.0)),
             )
         except (KeyError, ValueError, TypeError) as error:
             raise InvalidInputError(f"Malformed expectation {description!r}: {error}.") from error

@@ -123,6 +123,7 @@ class AnchorColumns:
     galleries: np.ndarray | None  # (A, G, D) bfloat16 bits
     gallery_lengths: np.ndarray  # (A,) int
     perceived_positions: np.ndarray | None = None  # (A, 3), only when some anchor has an expectation
+    search_radii: np.ndarray | None = None  # (A,), only when some anchor is being searched for
 
     @classmethod
     def from_anchors(cls, anchors: Sequence[Anchor]) -> AnchorColumns:
@@ -141,6 +142,7 @@ class AnchorColumns:
             perceived = np.array(
                 [a.position if a.expectation is None else a.perceived_position for a in anchors], dtype=np.float64
             ).reshape(count, 3)
+        radii = np.array([0.0 if a.expectation is None else a.expectation.radius for a in anchors], dtype=np.float64)
         return cls(
             class_names=np.array([a.class_name for a in anchors], dtype=object),
             positions=np.array([a.position for a in anchors], dtype=np.float64).reshape(count, 3),
@@ -150,6 +152,7 @@ class AnchorColumns:
             galleries=galleries,
             gallery_lengths=lengths,
             perceived_positions=perceived,
+            search_radii=radii if np.any(radii > 0.0) else None,
         )
 
 
@@ -190,6 +193,8 @@ def pair_features(
     rows = np.asarray(rows, dtype=np.intp)
     columns = np.asarray(columns, dtype=np.intp)
     distance = np.linalg.norm(percepts.positions[rows] - anchors.positions[columns], axis=1)
+    if anchors.search_radii is not None:  # anywhere in a searched disc is as good as its centre
+        distance = np.maximum(distance - anchors.search_radii[columns], 0.0)
     if anchors.perceived_positions is not None:
         perceived_distance = np.linalg.norm(percepts.positions[rows] - anchors.perceived_positions[columns], axis=1)
         distance = np.minimum(distance, perceived_distance)

@@ -56,7 +56,10 @@ class MatchingTableConfig:
     of one class often share); ``gate_class_mismatch``: never pair different classes;
     ``tracker_continuity_score``: the floor for a pair continuing a tracker id;
     ``continuation_maximum_age`` (s): how recent a continued anchor must be to skip scoring
-    (about a tracker's buffer); ``gated_score``: the penalty gated pairs hold (negative)."""
+    (about a tracker's buffer); ``gated_score``: the penalty gated pairs hold (negative);
+    ``search_score_cap``: the most a pair with an anchor being searched for (an expectation with a
+    radius) can score, below an in-place match and a tracker continuation, so that a look-alike
+    anchored where the search looks keeps its own percept."""
 
     base_gate: float = 3.0
     maximum_speed: float = 0.25
@@ -65,6 +68,7 @@ class MatchingTableConfig:
     tracker_continuity_score: float = 0.9
     continuation_maximum_age: float = 1.0
     gated_score: float = -1.0
+    search_score_cap: float = 0.7
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.base_gate) and self.base_gate > 0.0):
@@ -83,6 +87,8 @@ class MatchingTableConfig:
             raise ConfigurationError(
                 f"table continuation_maximum_age must be >= 0 seconds, got {self.continuation_maximum_age}."
             )
+        if not (0.0 < self.search_score_cap <= 1.0):
+            raise ConfigurationError(f"table search_score_cap must be in (0, 1], got {self.search_score_cap}.")
         if not self.gated_score < 0.0:
             raise ConfigurationError(f"table gated_score must be negative (below any score), got {self.gated_score}.")
 
@@ -156,6 +162,9 @@ class MatchingTableBuilder:
                 columns, anchor_columns, rows, score_columns, self.matcher.feature_config, self.matcher.uses_appearance
             )
             scores[rows, score_columns] = self.matcher.score_pairs(features)
+        if anchor_columns.search_radii is not None:
+            searched = (anchor_columns.search_radii > 0.0)[np.newaxis, :] & to_score
+            scores[searched] = np.minimum(scores[searched], self.config.search_score_cap)
         scores[shortcut] = np.where(eligible[shortcut], self.config.tracker_continuity_score, self.config.gated_score)
         scores = apply_tracker_continuity(scores, continuations, same_class, self.config.tracker_continuity_score)
         return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded)
@@ -170,13 +179,15 @@ class MatchingTableBuilder:
         if len(percepts.stamps) == 0 or len(index) == 0:
             return empty, empty
         radius = float(self.gate_radius(float(percepts.stamps.max()) - index.oldest_last_seen()))
+        radius += index.largest_search_radius()
         per_row = index.within(percepts.positions, radius)
         rows = np.repeat(np.arange(len(per_row), dtype=np.intp), [len(slots) for slots in per_row])
         if rows.size == 0:
             return empty, empty
         slots = np.concatenate(per_row).astype(np.intp)
         distance = np.linalg.norm(percepts.positions[rows] - index.positions_of(slots), axis=1)
-        passing = distance <= self.gate_radius(percepts.stamps[rows] - index.last_seen_of(slots))
+        reach = self.gate_radius(percepts.stamps[rows] - index.last_seen_of(slots)) + index.search_radii_of(slots)
+        passing = distance <= reach
         if self.config.gate_class_mismatch:
             passing &= percepts.class_names[rows] == index.class_names_of(slots)
         return rows[passing], slots[passing]

@@ -321,7 +321,7 @@ class AnchoringNode(Node):
                     raise ConfigurationError(f"no anchor '{request.symbol}'")
                 if request.expectation == request.EXPECT_AT:
                     self._anchoring.expect(request.symbol, Expectation.at(
-                        position, now, place=request.place, source=request.source))
+                        position, now, place=request.place, source=request.source, radius=float(request.radius)))
                 elif request.expectation == request.EXPECT_CARRIED:
                     self._anchoring.expect(request.symbol, Expectation.carried(
                         now, offset=position, source=request.source), robot_pose=self._robot_pose)

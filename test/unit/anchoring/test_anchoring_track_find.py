@@ -244,3 +244,71 @@ def test_snapshot_without_anchors_restores_to_empty():
     anchoring = Anchoring()
     anchoring.restore(Anchoring().snapshot())
     assert len(anchoring) == 0
+
+
+# --- top-down search (an expectation with a radius) -----------------------------------------
+
+
+def lose(anchoring, stamp):
+    """Look at the anchors' place and see nothing: they go missing."""
+    anchoring.process([], camera_view(), stamp)
+
+
+def test_a_missing_object_moved_elsewhere_is_reacquired_by_a_search(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    seen_twice(anchoring, maker, [cup])
+    lose(anchoring, 1.0)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    # 4 m away and 3 s later: without a search, a new anchor (too far to be the same object).
+    elsewhere = np.array(cup.position) + (0.0, 4.0, 0.0)
+    without = make_anchoring()
+    seen_twice(without, maker, [cup])
+    lose(without, 1.0)
+    assert without.process([maker.percept(cup, 4.0, position=elsewhere)], None, 4.0).percept_symbols == ("cup_2",)
+    # The searcher expects it somewhere within 2 m of the other room's waypoint.
+    waypoint = elsewhere + (1.5, 0.5, -0.8)
+    anchoring.expect("cup_1", Expectation.at(waypoint, stamp=3.0, place="bedroom", source="find", radius=2.0))
+    result = anchoring.process([maker.percept(cup, 4.0, position=elsewhere)], None, 4.0)
+    assert result.percept_symbols == ("cup_1",)
+    anchor = anchoring.get("cup_1")
+    assert anchor.state is AnchorState.CONFIRMED and anchor.expectation is None
+    np.testing.assert_allclose(anchor.position, elsewhere, atol=0.05)
+    confirmed = [e for e in result.events if e.kind is AnchorEventKind.CONFIRMED]
+    assert confirmed and confirmed[0].details["expectation"]["radius"] == 2.0
+
+
+def test_a_search_does_not_take_a_look_alike_already_anchored_there(make_anchoring, maker, twin_mugs):
+    anchoring = make_anchoring()
+    mug_a, mug_b = twin_mugs.values()
+    seen_twice(anchoring, maker, [mug_a, mug_b])
+    anchoring.process([maker.percept(mug_b, 0.5)], camera_view(), 0.5)  # mug_a not seen: missing
+    missing = [a.symbol for a in anchoring.anchors if a.state is AnchorState.MISSING]
+    assert len(missing) == 1
+    (other,) = [a.symbol for a in anchoring.anchors if a.symbol not in missing]
+    # Search for the missing mug right where its twin is: the twin keeps its own percept.
+    anchoring.expect(missing[0], Expectation.at(mug_b.position, stamp=0.6, source="find", radius=2.0))
+    result = anchoring.process([maker.percept(mug_b, 0.7)], camera_view(), 0.7)
+    assert result.percept_symbols == (other,)
+    assert anchoring.get(missing[0]).expectation is not None  # still being searched for
+
+
+def test_a_search_seen_empty_is_not_retracted_and_clearing_it_restores_the_anchor(make_anchoring, maker, kitchen):
+    anchoring = make_anchoring()
+    seen_twice(anchoring, maker, [kitchen["red_cup"]])
+    lose(anchoring, 1.0)
+    perceived = anchoring.get("cup_1").position.copy()
+    anchoring.expect("cup_1", Expectation.at((2.5, 0.0, 0.8), stamp=1.5, source="find", radius=1.5))
+    result = anchoring.process([], camera_view(depth=flat_depth(6.0)), 2.0)
+    assert result.events == ()
+    anchoring.clear_expectation("cup_1")
+    anchor = anchoring.get("cup_1")
+    assert anchor.expectation is None and anchor.state is AnchorState.MISSING
+    np.testing.assert_array_equal(anchor.position, perceived)
+
+
+def test_only_a_place_can_be_searched():
+    with pytest.raises(InvalidInputError, match="radius"):
+        Expectation.at((0, 0, 0), stamp=0.0, radius=-1.0)
+    with pytest.raises(InvalidInputError, match="place"):
+        Expectation(Expectation.carried(0.0).kind, np.zeros(3), 0.0, radius=1.0)
