@@ -228,6 +228,7 @@ class Dispatcher:
         blackboard[PLAN_STEP_KEY] = step.step
         with self._lock:
             self._running_behaviour = behaviour
+        _logger.info("running %s", step.step)
         try:
             outcome = behaviour(blackboard)
         except Exception as error:  # a bug in a behaviour: replanning would only repeat it
@@ -237,6 +238,7 @@ class Dispatcher:
             with self._lock:
                 self._running_behaviour = None
                 self._running_needs = frozenset()
+        _logger.info("%s %s", step.step, outcome)
         if outcome == SUCCEED:
             self._write(lambda: self._effects.apply(step.end_effects))
             return _Run(_Ending.DONE)

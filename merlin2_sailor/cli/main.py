@@ -21,6 +21,8 @@ SUBCOMMANDS = (
     "merlin2_sailor.cli.anchors_command",
     "merlin2_sailor.cli.train_command",
     "merlin2_sailor.cli.evaluate_command",
+    "merlin2_sailor.cli.replay",
+    "merlin2_sailor.cli.bench",
 )
 
 

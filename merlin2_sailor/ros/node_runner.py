@@ -40,6 +40,9 @@ def run_node(
     ``threads`` > 1 uses a multi-threaded executor, for nodes whose service callbacks must not
     wait behind long subscription callbacks. A SailorError while building the node (a bad
     parameter, a missing model file) is logged as one line and exits with code 2.
+
+    A node with a job that ends (a mission) sets an ``exit_code`` attribute when it is done:
+    the spin stops and the process exits with that code.
     """
     arguments = list(argv) if argv is not None else sys.argv
     try:
@@ -58,6 +61,9 @@ def run_node(
         executor.add_node(node)
         while not stop_requested.is_set() and rclpy.ok():
             executor.spin_once(timeout_sec=SPIN_SLICE_SECONDS)
+            exit_code = getattr(node, "exit_code", None)
+            if exit_code is not None:
+                return int(exit_code)
     except ExternalShutdownException:
         pass
     except SailorError as error:

@@ -1,0 +1,108 @@
+"""The demo's scorecard counts what a user checks by eye on the map, and the map is drawn."""
+
+import cv2
+import numpy as np
+
+from merlin2_sailor_demos.report import (
+    AnchorRecord,
+    IdentityHistory,
+    MapLayers,
+    TrueObject,
+    associate,
+    draw_map,
+    score,
+)
+
+TRUTH = [
+    TrueObject("mug_a", "cup", (1.0, 0.0, 0.8)),
+    TrueObject("mug_b", "cup", (4.0, 0.0, 0.8)),
+    TrueObject("plant", "potted plant", (2.0, 2.0, 0.0)),
+    TrueObject("book", "book", (0.0, 3.0, 0.5)),
+]
+
+
+def test_association_is_one_to_one_same_class_and_gated():
+    anchors = [
+        AnchorRecord("cup_1", "cup", (1.1, 0.0, 0.8)),
+        AnchorRecord("cup_2", "cup", (1.2, 0.1, 0.8)),  # a duplicate of mug_a
+        AnchorRecord("potted_plant_1", "cup", (2.0, 2.0, 0.0)),  # wrong class: never the plant
+        AnchorRecord("book_1", "book", (0.0, 4.0, 0.5)),  # a metre off: beyond the gate
+    ]
+    assert associate(TRUTH, anchors) == {"mug_a": "cup_1"}
+
+
+def test_the_scorecard_counts_misses_duplicates_errors_and_facts():
+    anchors = [
+        AnchorRecord("cup_1", "cup", (1.1, 0.0, 0.8)),
+        AnchorRecord("cup_2", "cup", (1.3, 0.0, 0.8)),
+        AnchorRecord("cup_3", "cup", (4.35, 0.0, 0.8)),
+        AnchorRecord("potted_plant_1", "potted plant", (2.0, 2.0, 0.0), state="missing"),
+        AnchorRecord("book_1", "book", (9.0, 9.0, 0.5)),
+        AnchorRecord("book_2", "book", (0.0, 3.0, 0.5), state="tentative"),  # no claim yet
+    ]
+    places = {"mug_a": "kitchen", "mug_b": "hall", "plant": "kitchen"}
+    card = score(
+        TRUTH,
+        anchors,
+        facts=[("cup_1", "kitchen"), ("cup_3", "kitchen"), ("book_1", "bedroom")],
+        place_of=lambda obj: places.get(obj.id),
+    )
+    assert card.anchored == 3 and card.not_anchored == ("book",)
+    assert card.duplicates == ("cup_2",) and card.spurious == ("book_1",)
+    assert card.wrong_positions == ("mug_b",)
+    assert abs(card.position_errors["mug_b"] - 0.35) < 1e-9
+    assert card.facts_right == 1
+    assert card.facts_wrong == ("object_at(cup_3, kitchen)", "object_at(book_1, bedroom)")
+    table = card.to_markdown()
+    assert "| anchored (exactly one anchor each) | 3 / 4 |" in table and "book_1" in table
+
+
+def test_identity_switches_are_symbol_changes_of_one_object():
+    history = IdentityHistory()
+    history.record({"mug_a": "cup_1", "mug_b": "cup_2"})
+    history.record({"mug_a": "cup_1"})  # mug_b out of view: no switch
+    history.record({"mug_a": "cup_2", "mug_b": "cup_1"})  # the look-alikes swapped symbols
+    history.record({"mug_a": "cup_2", "mug_b": "cup_1"})
+    assert history.switches == {"mug_a": 1, "mug_b": 1}
+    assert history.symbols["mug_a"] == ["cup_1", "cup_2"]
+    card = score(TRUTH[:2], [AnchorRecord("cup_2", "cup", (1, 0, 0.8)), AnchorRecord("cup_1", "cup", (4, 0, 0.8))],
+                 history=history)
+    assert card.total_switches == 2
+
+
+def test_the_map_is_a_png_with_everything_drawn(tmp_path):
+    layers = MapLayers(
+        rooms=[("kitchen", (0.0, -1.0, 3.0, 2.0)), ("hall", (3.0, -1.0, 6.0, 4.0))],
+        furniture=[(0.5, -0.5, 1.5, 0.5)],
+        waypoints=[("kitchen", 1.5, 1.0), ("hall", 4.5, 1.0)],
+        robot_path=[(1.5, 1.0), (3.0, 1.0), (4.5, 1.0)],
+    )
+    anchors = [AnchorRecord("cup_1", "cup", (1.1, 0.0, 0.8)), AnchorRecord("cup_2", "cup", (4.0, 0.2, 0.8), "missing")]
+    path = draw_map(tmp_path / "map.png", layers, TRUTH, anchors, associate(TRUTH, anchors), title="run")
+    image = cv2.imread(str(path))
+    assert image is not None and image.shape[0] > 200 and image.shape[1] > 300
+    colours = {tuple(c) for c in image.reshape(-1, 3)[:: 7].tolist()}
+    assert (60, 160, 60) in colours  # true objects
+    assert (40, 40, 220) in colours  # the missing anchor
+    assert np.count_nonzero(np.all(image == (200, 90, 30), axis=2)) > 10  # the confirmed anchor
+
+
+def test_anchors_are_projected_into_the_frame_where_they_are():
+    from merlin2_sailor.perception.camera_model import CameraIntrinsics
+    from merlin2_sailor.perception.pose import Pose
+    from merlin2_sailor_demos.report.annotated_frame import AnchorInView, anchor_box, annotate_frame
+
+    intrinsics = CameraIntrinsics(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)
+    # Optical frame (z forward, x right, y down) looking along world +x from (0, 0, 1).
+    camera = Pose(np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]), np.array([0.0, 0.0, 1.0]))
+    ahead = AnchorInView("cup_1", "confirmed", (2.0, 0.0, 1.0), (0.2, 0.2, 0.2), seen_now=True)
+    x0, y0, x1, y1 = anchor_box(ahead, intrinsics, camera)
+    assert abs((x0 + x1) / 2 - 320) <= 1 and abs((y0 + y1) / 2 - 240) <= 1
+    assert 50 <= x1 - x0 <= 60  # 0.2 m at 1.9-2.1 m with f = 500 px
+    behind = AnchorInView("cup_2", "missing", (-2.0, 0.0, 1.0), (0.2, 0.2, 0.2), seen_now=False)
+    assert anchor_box(behind, intrinsics, camera) is None
+    frame = np.zeros((480, 640, 3), dtype=np.uint8)
+    drawn = annotate_frame(frame, intrinsics, camera, [ahead, behind], [(300, 220, 340, 260)], caption="t=1.0 s")
+    assert frame.max() == 0  # the input is left alone
+    assert np.all(drawn[y0, x0 + 5 : x1 - 5] == (30, 90, 200))  # the anchor's box edge, confirmed colour
+    assert drawn[460:478, 0:80].max() == 255  # the caption
