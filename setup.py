@@ -21,6 +21,7 @@ NODE_ENTRY_POINTS = [
     "anchoring = merlin2_sailor.ros.anchoring_node:main",
     "detector = merlin2_sailor.ros.detector_node:main",
     "percept_generator = merlin2_sailor.ros.percept_node:main",
+    "behaviors = merlin2_sailor_behaviors.ros.behaviors_node:main",
 ]
 
 # Command-line tools.
@@ -28,11 +29,19 @@ TOOL_ENTRY_POINTS = [
     "sailor = merlin2_sailor.cli.main:main",
 ]
 
+
+
+def _packages_under(folder: str, package: str) -> list[str]:
+    """``package`` (installed from ``folder``) and every subpackage of it."""
+    return [package] + [f"{package}.{name}" for name in find_packages(where=folder)]
+
+
 setup(
     name=PACKAGE_NAME,
     version="0.1.0",
     packages=find_packages(include=[PACKAGE_NAME, f"{PACKAGE_NAME}.*"])
-    + ["merlin2_sailor_behaviors", "merlin2_sailor_demos"],
+    + _packages_under("behaviors", "merlin2_sailor_behaviors")
+    + _packages_under("demos", "merlin2_sailor_demos"),
     package_dir={
         "merlin2_sailor_behaviors": "behaviors",
         "merlin2_sailor_demos": "demos",

@@ -18,7 +18,9 @@ from rclpy.node import Node
 class BackgroundSpinner:
     def __init__(self, thread_name: str = "ros-background-spinner") -> None:
         self.context = rclpy.Context()
-        rclpy.init(context=self.context)
+        # No arguments: the process's own --ros-args (a __node:= remap of the node that owns this
+        # spinner) must not rename the private nodes spinning here.
+        rclpy.init(args=[], context=self.context)
         self._executor = SingleThreadedExecutor(context=self.context)
         self._nodes: list[Node] = []
         self._thread = threading.Thread(target=self._spin, name=thread_name, daemon=True)

@@ -7,12 +7,13 @@ from pathlib import Path
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 
-from merlin2_sailor_interfaces import msg, srv
+from merlin2_sailor_interfaces import action, msg, srv
 
 # Every type defined in the interfaces package's sources, so a new .msg or .srv is tested at once.
 INTERFACES_SOURCE = Path(__file__).resolve().parents[2] / "merlin2_sailor_interfaces"
 MESSAGE_TYPES = [getattr(msg, path.stem) for path in sorted(INTERFACES_SOURCE.glob("msg/*.msg"))]
 SERVICE_TYPES = [getattr(srv, path.stem) for path in sorted(INTERFACES_SOURCE.glob("srv/*.srv"))]
+ACTION_TYPES = [getattr(action, path.stem) for path in sorted(INTERFACES_SOURCE.glob("action/*.action"))]
 
 
 def test_the_interfaces_cover_detections_percepts_anchors_and_the_knowledge_base() -> None:
@@ -77,3 +78,30 @@ def test_every_service_request_and_response_round_trips(service_type: type) -> N
         assert deserialize_message(serialize_message(original), part) == original
     response = srv.FindAnchor.Response(found=True, anchor=sample_anchor(), message="")
     assert deserialize_message(serialize_message(response), srv.FindAnchor.Response) == response
+
+
+def test_the_interfaces_cover_navigation_and_running_plan_steps() -> None:
+    assert {action_type.__name__ for action_type in ACTION_TYPES} >= {"NavigateToPose", "RunPddlAction"}
+
+
+@pytest.mark.parametrize("action_type", ACTION_TYPES, ids=lambda t: t.__name__)
+def test_every_action_goal_result_and_feedback_round_trips(action_type: type) -> None:
+    for part in (action_type.Goal, action_type.Result, action_type.Feedback):
+        original = part()
+        assert deserialize_message(serialize_message(original), part) == original
+    # The wrapper messages rclpy's action client and server exchange.
+    for part in (action_type.Impl.SendGoalService.Request, action_type.Impl.GetResultService.Response,
+                 action_type.Impl.FeedbackMessage):
+        original = part()
+        assert deserialize_message(serialize_message(original), part) == original
+
+
+def test_a_filled_plan_step_goal_and_result_round_trip() -> None:
+    goal = action.RunPddlAction.Goal(action_name="bring", objects=["cup_1", "kitchen", "bedroom"])
+    assert deserialize_message(serialize_message(goal), action.RunPddlAction.Goal) == goal
+    result = action.RunPddlAction.Result(outcome="aborted", message="could not pick cup_1")
+    assert deserialize_message(serialize_message(result), action.RunPddlAction.Result) == result
+    navigation = action.NavigateToPose.Goal()
+    navigation.pose.header.frame_id = "map"
+    navigation.pose.pose.position.x, navigation.pose.pose.orientation.w = 2.0, 1.0
+    assert deserialize_message(serialize_message(navigation), action.NavigateToPose.Goal) == navigation

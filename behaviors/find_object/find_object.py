@@ -1,0 +1,276 @@
+"""find_object(?target - object ?origin - wp): SAILOR's top-down Find, as a state machine.
+
+Given an object's symbol (``target``), or, outside PDDL, a detector class (``class_name`` on the
+blackboard), the robot searches for it:
+
+1. PLANNING_SEARCH: ask the anchoring layer where it was last anchored (``find_anchor``); the
+   search visits the waypoint nearest that place first, then every other waypoint, each next
+   stop the nearest to the last (with no anchor, starting from the waypoint nearest the robot).
+2. For each stop: GOING_TO_STOP, EXPECTING (EXPECT_AT for the sought symbol: at the place it
+   was last anchored, exactly; at any other stop, as a search within ``search_radius`` of it, so
+   the anchoring layer may take a percept of its class anywhere there as the sought anchor,
+   though never one that a look-alike anchored there explains better), LOOKING_AROUND (stops
+   early on a reacquisition) and CHECKING (wait up to ``reacquire_timeout`` for the anchor to
+   be confirmed and seen since the search began; not found: the search expectation is cleared,
+   so the anchor goes back to where it was last perceived).
+3. On success the robot stays at that stop, and the behaviour writes ``robot_at(<stop>)``
+   (DECLARED) in the knowledge base itself: the dispatcher only knows ``origin``. The anchored
+   facts (``object_at``, ``missing``) are perception's to update.
+4. Not found anywhere: RETURNING to ``origin`` (so the ``robot_at(origin)`` the dispatcher
+   restores after an abort is true; ``return_on_failure``), then GIVING_UP: aborted, naming
+   every stop searched. A stop the robot cannot reach is a warning and the search goes on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from merlin2_sailor_behaviors.actions.clients import AnchorReport, Pose2D
+from merlin2_sailor_behaviors.actions.context import BehaviorContext
+from merlin2_sailor_behaviors.actions.domain import FIND_OBJECT, WP_TYPE, predicates_of
+from merlin2_sailor_behaviors.actions.errors import BehaviorError
+from merlin2_sailor_behaviors.actions.keys import CLASS_NAME_KEY, FOUND_AT_KEY, FOUND_SYMBOL_KEY
+from merlin2_sailor_behaviors.actions.robot_location import declare_robot_at
+from merlin2_sailor_behaviors.actions.sailor_action import SailorAction
+from merlin2_sailor_behaviors.actions.states import (
+    BehaviorState,
+    CallbackState,
+    GoTo,
+    LookAround,
+    Target,
+    abort,
+    place_target,
+    wait_until,
+    warn,
+)
+from merlin2_sailor_behaviors.state_machines import ABORT, CANCEL, SUCCEED, Blackboard, StateMachine
+
+FIND_SOURCE = "find_object"
+"""The ``source`` of the expectations find_object announces."""
+
+NEXT = "next"
+EXHAUSTED = "exhausted"
+NOT_HERE = "not_here"
+UNREACHABLE = "unreachable"
+
+SEARCH_KEY = "find_object.search"
+STOP_KEY = "find_object.stop"
+TARGET_KEY = "find_object.target"
+RETURN_KEY = "find_object.return"
+
+
+@dataclass
+class Search:
+    """What is sought, where it was last anchored, the stops, and progress through them."""
+
+    symbol: str
+    class_name: str
+    last_seen: AnchorReport | None
+    """The anchor as find_anchor reported it when the search began (None: nothing anchored)."""
+    last_place: str | None
+    stops: list[str]
+    baselines: dict[str, AnchorReport] = field(default_factory=dict)
+    """Each candidate anchor as it was when the search began: a sighting must be newer."""
+    next_stop: int = 0
+    unreachable: list[str] = field(default_factory=list)
+
+    @property
+    def sought(self) -> str:
+        return self.symbol or f"an object of class {self.class_name!r}"
+
+
+def plan_search(state: BehaviorState, blackboard: Blackboard) -> str:
+    context = state.context
+    symbol = str(blackboard["target"]) if "target" in blackboard else ""
+    class_name = str(blackboard[CLASS_NAME_KEY]) if CLASS_NAME_KEY in blackboard else ""
+    if not symbol and not class_name:
+        return abort(blackboard, f"find_object needs a 'target' symbol or a '{CLASS_NAME_KEY}' on the blackboard")
+    robot = context.navigation.robot_pose()
+    if symbol:
+        anchor = context.anchoring.find_anchor(symbol=symbol)
+        if anchor is None:
+            return abort(
+                blackboard,
+                f"the anchoring layer has no anchor {symbol!r} to find: it was never anchored or has been forgotten",
+            )
+        baselines = {symbol: anchor}
+    else:
+        near = None if robot is None else (robot.x, robot.y, 0.0)
+        anchor = context.anchoring.find_anchor(class_name=class_name, near=near)
+        baselines = {report.symbol: report for report in context.anchoring.get_anchors(class_name)}
+    last_place = None if anchor is None else context.places.nearest_waypoint(anchor.position[0], anchor.position[1])
+    waypoints = context.places.waypoint_names()
+    if not waypoints:
+        return abort(blackboard, "the map (grounding configuration) has no waypoint to search")
+    start = last_place
+    if start is None and robot is not None:
+        start = context.places.nearest_waypoint(robot.x, robot.y)
+    if start is None and "origin" in blackboard and blackboard["origin"] in waypoints:
+        start = blackboard["origin"]
+    stops = context.places.tour(start or waypoints[0], waypoints)
+    search = Search(symbol, class_name, anchor, last_place, stops, baselines)
+    blackboard[SEARCH_KEY] = search
+    context.log("info", f"searching for {search.sought} at {', '.join(stops)}")
+    return SUCCEED
+
+
+def next_stop(state: BehaviorState, blackboard: Blackboard) -> str:
+    search: Search = blackboard[SEARCH_KEY]
+    if search.next_stop >= len(search.stops):
+        return EXHAUSTED
+    stop = search.stops[search.next_stop]
+    search.next_stop += 1
+    target = place_target(state.context, stop)
+    place = state.context.places.get(stop)
+    if stop == search.last_place and search.last_seen is not None and place.yaw is None:
+        # Arrive facing where the object was last seen: it is the first thing the camera sees.
+        facing = target.pose.facing(search.last_seen.position[0], search.last_seen.position[1])
+        target = Target(stop, Pose2D(target.pose.x, target.pose.y, facing.yaw))
+    blackboard[STOP_KEY] = stop
+    blackboard[TARGET_KEY] = target
+    return NEXT
+
+
+def note_unreachable(state: BehaviorState, blackboard: Blackboard) -> str:
+    search: Search = blackboard[SEARCH_KEY]
+    search.unreachable.append(blackboard[STOP_KEY])
+    return SUCCEED
+
+
+def expect_here(state: BehaviorState, blackboard: Blackboard) -> str:
+    """EXPECT_AT for the sought symbol at this stop: at its last position when this is the place
+    it was last anchored, else at the stop's point (at the height it was last seen)."""
+    search: Search = blackboard[SEARCH_KEY]
+    if not search.symbol:
+        return SUCCEED  # a class has no anchor to move; any new anchor of it will do
+    stop = blackboard[STOP_KEY]
+    last = search.last_seen
+    radius = 0.0
+    if last is not None and stop == search.last_place:
+        position = last.position
+    else:
+        place = state.context.places.get(stop)
+        position = (place.x, place.y, last.position[2] if last is not None else 0.0)
+        radius = state.context.config.search_radius
+    try:
+        state.context.anchoring.expect_at(search.symbol, position, stop, FIND_SOURCE, radius)
+    except BehaviorError as error:
+        warn(state.context, blackboard, f"cannot announce {search.symbol} at {stop}: {error}")
+    return SUCCEED
+
+
+def reacquired(context: BehaviorContext, search: Search) -> AnchorReport | None:
+    """The sought anchor if it has been confirmed and seen since the search began."""
+    if search.symbol:
+        anchor = context.anchoring.get_anchor(search.symbol)
+        baseline = search.baselines.get(search.symbol)
+        return anchor if anchor is not None and anchor.seen_since(baseline) else None
+    candidates = [
+        anchor
+        for anchor in context.anchoring.get_anchors(search.class_name)
+        if anchor.seen_since(search.baselines.get(anchor.symbol))
+    ]
+    return max(candidates, key=lambda anchor: (anchor.last_seen, anchor.symbol), default=None)
+
+
+def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
+    context = state.context
+    search: Search = blackboard[SEARCH_KEY]
+    stop = blackboard[STOP_KEY]
+    found: list[AnchorReport] = []
+
+    def seen() -> bool:
+        anchor = reacquired(context, search)
+        if anchor is not None:
+            found.append(anchor)
+        return anchor is not None
+
+    if not wait_until(seen, context.config.reacquire_timeout, context.config.poll_period, state):
+        if search.symbol:
+            try:
+                context.anchoring.clear_expectation(search.symbol, FIND_SOURCE)
+            except BehaviorError as error:
+                warn(context, blackboard, f"cannot withdraw the search for {search.symbol} at {stop}: {error}")
+        if state.is_canceled():
+            return CANCEL
+        context.log("info", f"{search.sought} is not at {stop}")
+        return NOT_HERE
+    declare_robot_at(context.store, stop)
+    blackboard[FOUND_SYMBOL_KEY] = found[-1].symbol
+    blackboard[FOUND_AT_KEY] = stop
+    context.log("info", f"found {found[-1].symbol} at {stop}")
+    return SUCCEED
+
+
+def plan_return(state: BehaviorState, blackboard: Blackboard) -> str:
+    """Head back to ``origin`` when configured to and it is known; else give up where we are."""
+    origin = blackboard["origin"] if "origin" in blackboard else ""
+    if not state.context.config.return_on_failure or origin not in state.context.places.names():
+        return EXHAUSTED
+    blackboard[RETURN_KEY] = place_target(state.context, origin)
+    return NEXT
+
+
+def give_up(state: BehaviorState, blackboard: Blackboard) -> str:
+    search: Search = blackboard[SEARCH_KEY]
+    searched = [stop for stop in search.stops if stop not in search.unreachable]
+    message = f"{search.sought} was not found at {', '.join(searched) or 'any stop'}"
+    if search.unreachable:
+        message += f" (could not reach {', '.join(search.unreachable)})"
+    return abort(blackboard, message)
+
+
+def note_failed_return(state: BehaviorState, blackboard: Blackboard) -> str:
+    warn(state.context, blackboard, f"could not drive back to {blackboard['origin']} after the search")
+    return SUCCEED
+
+
+def find_object_state_machine(context: BehaviorContext) -> StateMachine:
+    """The find_object behaviour: reads ``target`` (or ``class_name``) and ``origin``."""
+    machine = StateMachine(outcomes=[SUCCEED, ABORT, CANCEL])
+    machine.add_state("PLANNING_SEARCH", CallbackState(context, plan_search), {SUCCEED: "NEXT_STOP"})
+    machine.add_state(
+        "NEXT_STOP",
+        CallbackState(context, next_stop, (NEXT, EXHAUSTED, ABORT, CANCEL)),
+        {NEXT: "GOING_TO_STOP", EXHAUSTED: "RETURNING_HOME"},
+    )
+    machine.add_state(
+        "GOING_TO_STOP",
+        GoTo(context, TARGET_KEY, failed_outcome=UNREACHABLE),
+        {SUCCEED: "EXPECTING", UNREACHABLE: "NOTING_UNREACHABLE"},
+    )
+    machine.add_state("NOTING_UNREACHABLE", CallbackState(context, note_unreachable), {SUCCEED: "NEXT_STOP"})
+    machine.add_state("EXPECTING", CallbackState(context, expect_here), {SUCCEED: "LOOKING_AROUND"})
+    machine.add_state(
+        "LOOKING_AROUND",
+        LookAround(
+            context,
+            TARGET_KEY,
+            required=False,
+            stop_when=lambda blackboard: reacquired(context, blackboard[SEARCH_KEY]) is not None,
+        ),
+        {SUCCEED: "CHECKING"},
+    )
+    machine.add_state(
+        "CHECKING",
+        CallbackState(context, check_here, (SUCCEED, NOT_HERE, ABORT, CANCEL)),
+        {NOT_HERE: "NEXT_STOP"},
+    )
+    machine.add_state(
+        "RETURNING_HOME",
+        CallbackState(context, plan_return, (NEXT, EXHAUSTED, ABORT, CANCEL)),
+        {NEXT: "RETURNING", EXHAUSTED: "GIVING_UP"},
+    )
+    machine.add_state(
+        "RETURNING",
+        GoTo(context, RETURN_KEY, failed_outcome=UNREACHABLE),
+        {SUCCEED: "GIVING_UP", UNREACHABLE: "NOTING_FAILED_RETURN"},
+    )
+    machine.add_state(
+        "NOTING_FAILED_RETURN", CallbackState(context, note_failed_return), {SUCCEED: "GIVING_UP"}
+    )
+    machine.add_state("GIVING_UP", CallbackState(context, give_up))
+    return machine
+
+
+FIND_OBJECT_ACTION = SailorAction(FIND_OBJECT, (WP_TYPE,), predicates_of(FIND_OBJECT), find_object_state_machine)

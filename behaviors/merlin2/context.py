@@ -1,0 +1,55 @@
+"""The behaviours' context on a MERLIN2 action node: ROS clients on that node, KANT as the store.
+
+MERLIN2's knowledge base is KANT, reached through the DAO factory every MERLIN2 action node owns
+(``node.dao_factory``), so the behaviours read and write it through
+:class:`~merlin2_sailor.knowledge.kant_store.KantStore`. The clients (anchoring services,
+NavigateToPose, Grasp) are the same as the ``behaviors`` node's, created on the MERLIN2 node,
+which MERLIN2 spins on a multi-threaded executor of its own.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+from rclpy.callback_groups import ReentrantCallbackGroup
+
+from merlin2_sailor.knowledge.grounding import GroundingConfig
+from merlin2_sailor.knowledge.kant_store import KantStore
+from merlin2_sailor.resources import config_file
+from merlin2_sailor_behaviors.actions.context import BehaviorConfig, BehaviorContext
+from merlin2_sailor_behaviors.actions.places import Places
+from merlin2_sailor_behaviors.merlin2.fsm_action import ContextFactory
+from merlin2_sailor_behaviors.ros.anchoring_client import RosAnchoringClient
+from merlin2_sailor_behaviors.ros.grasp_client import RosGraspClient
+from merlin2_sailor_behaviors.ros.navigation_client import RosNavigationClient
+from merlin2_sailor_behaviors.ros.service_caller import ServiceCaller
+
+
+def ros_context_factory(
+    grounding_file: str = "",
+    anchoring: str = "/anchoring",
+    navigation_action: str = "navigate_to_pose",
+    robot_pose_topic: str = "robot_pose",
+    frame_id: str = "map",
+    grasp_service: str = "/world/grasp",
+    service_timeout: float = 2.0,
+    config: BehaviorConfig | None = None,
+) -> ContextFactory:
+    """A factory of contexts for MERLIN2 action nodes, with the ``behaviors`` node's defaults."""
+    places = Places.from_grounding(GroundingConfig.from_yaml(grounding_file or config_file("grounding.yaml")))
+
+    def make_context(node: Any, stopping: threading.Event) -> BehaviorContext:
+        group = ReentrantCallbackGroup()
+        caller = ServiceCaller(node, service_timeout, stopping, group)
+        return BehaviorContext(
+            store=KantStore(node.dao_factory),
+            anchoring=RosAnchoringClient(caller, anchoring),
+            navigation=RosNavigationClient(node, stopping, navigation_action, robot_pose_topic, frame_id,
+                                           callback_group=group),
+            grasp=RosGraspClient(caller, grasp_service),
+            places=places,
+            config=config or BehaviorConfig(),
+        )
+
+    return make_context

@@ -1,0 +1,192 @@
+"""find_object and bring with fake navigation, anchoring and gripper (no ROS)."""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import pytest
+
+from merlin2_sailor.anchoring.anchor import AnchorState
+from merlin2_sailor.knowledge import PddlObject, Proposition
+from merlin2_sailor_behaviors.actions import (
+    CLASS_NAME_KEY,
+    FOUND_AT_KEY,
+    FOUND_SYMBOL_KEY,
+    REASON_KEY,
+    WARNINGS_KEY,
+    BehaviorConfig,
+    GraspResult,
+    Pose2D,
+)
+from merlin2_sailor_behaviors.actions.robot_location import robot_locations
+from merlin2_sailor_behaviors.find_object import FIND_OBJECT_ACTION, FIND_SOURCE, find_object_state_machine
+from merlin2_sailor_behaviors.manipulation import BRING_ACTION, BRING_SOURCE
+from merlin2_sailor_behaviors.state_machines import ABORT, CANCEL, SUCCEED, Blackboard
+
+from .fake_robot import FAST, WAYPOINTS, FakeRobot, make_robot
+
+
+@pytest.fixture
+def robot() -> FakeRobot:
+    robot = make_robot()
+    robot.store.objects.save(PddlObject("cup_1", "cup"))
+    robot.store.propositions.save(Proposition("missing", ("cup_1",)))
+    robot.store.propositions.save(Proposition("robot_at", ("a",)))
+    robot.anchoring.add("cup_1", "cup", (2.2, 0.1, 0.8), AnchorState.MISSING)  # last anchored near b
+    return robot
+
+
+def find(robot: FakeRobot, *objects: str) -> tuple[str, dict]:
+    blackboard = FIND_OBJECT_ACTION.blackboard_for(objects)
+    outcome = FIND_OBJECT_ACTION.make_state_machine(robot.context)(blackboard)
+    return outcome, dict(blackboard)
+
+
+def stops(robot: FakeRobot) -> list[str]:
+    """The waypoints the robot drove to, in order, without the turns made at each."""
+    named = {xy: name for name, xy in WAYPOINTS.items()}
+    visited: list[str] = []
+    for position in robot.navigation.positions():
+        name = named.get(position)
+        if name is not None and (not visited or visited[-1] != name):
+            visited.append(name)
+    return visited
+
+
+def test_find_goes_first_to_where_it_was_last_anchored_and_succeeds_there(robot: FakeRobot) -> None:
+    robot.world["cup_1"] = (2.2, 0.1)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == SUCCEED, blackboard.get(REASON_KEY)
+    assert stops(robot) == ["b"]
+    assert robot.navigation.goals[0].yaw == pytest.approx(math.atan2(0.1, 0.2))  # facing its last place
+    at = robot.anchoring.expectations[0]
+    assert (at.kind, at.symbol, at.position, at.place, at.source) == ("at", "cup_1", (2.2, 0.1, 0.8), "b", FIND_SOURCE)
+    assert len(robot.navigation.goals) == 1  # seen on arrival: the look around stopped at once
+    assert blackboard[FOUND_SYMBOL_KEY] == "cup_1" and blackboard[FOUND_AT_KEY] == "b"
+    assert robot_locations(robot.store) == ("b",)  # written by the behaviour, DECLARED
+
+
+def test_find_searches_the_other_waypoints_nearest_first_expecting_it_at_each(robot: FakeRobot) -> None:
+    robot.world["cup_1"] = (5.1, 0.0)  # really at c, the last stop of the tour
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == SUCCEED, blackboard.get(REASON_KEY)
+    # From b, the nearest is a (2 m), then d (from a: 3.6 m; c: 5 m), then c (from d: 4.2 m).
+    assert stops(robot) == ["b", "a", "d", "c"]
+    announced = [(e.kind, e.place, e.position, e.radius) for e in robot.anchoring.expectations]
+    # Exactly where it was last anchored; a search around every other stop, withdrawn when empty.
+    radius = robot.context.config.search_radius
+    assert radius > 0
+    assert announced == [
+        ("at", "b", (2.2, 0.1, 0.8), 0.0), ("clear", "", (0.0, 0.0, 0.0), 0.0),
+        ("at", "a", (0.0, 0.0, 0.8), radius), ("clear", "", (0.0, 0.0, 0.0), 0.0),
+        ("at", "d", (2.0, 3.0, 0.8), radius), ("clear", "", (0.0, 0.0, 0.0), 0.0),
+        ("at", "c", (5.0, 0.0, 0.8), radius),
+    ]
+    assert blackboard[FOUND_AT_KEY] == "c" and robot_locations(robot.store) == ("c",)
+
+
+def test_find_that_finds_nothing_aborts_after_every_waypoint_and_returns_to_its_origin(robot: FakeRobot) -> None:
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT
+    assert blackboard[REASON_KEY] == "cup_1 was not found at b, a, d, c"
+    assert stops(robot) == ["b", "a", "d", "c", "a"]  # back where the dispatcher will say it is
+    assert robot_locations(robot.store) == ("a",)  # untouched by the behaviour
+
+
+def test_find_goes_on_past_a_waypoint_it_cannot_reach(robot: FakeRobot) -> None:
+    robot.navigation.unreachable.add((0.0, 0.0))
+    robot.world["cup_1"] = (2.0, 3.0)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == SUCCEED and blackboard[FOUND_AT_KEY] == "d"
+    assert any("could not reach a" in warning for warning in blackboard[WARNINGS_KEY])
+
+
+def test_find_of_an_unanchored_symbol_aborts_with_a_clear_message(robot: FakeRobot) -> None:
+    robot.store.objects.save(PddlObject("cup_7", "cup"))
+    outcome, blackboard = find(robot, "cup_7", "a")
+    assert outcome == ABORT and "no anchor 'cup_7'" in blackboard[REASON_KEY]
+    assert robot.navigation.goals == []
+
+
+def test_find_by_class_name_outside_pddl_takes_any_anchor_of_that_class_seen_again(robot: FakeRobot) -> None:
+    robot.world["cup_1"] = (2.0, 3.2)
+    blackboard = Blackboard()
+    blackboard[CLASS_NAME_KEY] = "cup"
+    outcome = find_object_state_machine(robot.context)(blackboard)
+    assert outcome == SUCCEED, blackboard[REASON_KEY] if REASON_KEY in blackboard else ""
+    assert blackboard[FOUND_SYMBOL_KEY] == "cup_1" and blackboard[FOUND_AT_KEY] == "d"
+    assert robot.anchoring.expectations == []  # a class has no anchor to move
+
+
+def test_cancelling_find_reaches_the_running_state(robot: FakeRobot) -> None:
+    robot.navigation.block = True
+    machine = FIND_OBJECT_ACTION.make_state_machine(robot.context)
+    outcomes: list[str] = []
+    blackboard = FIND_OBJECT_ACTION.blackboard_for(("cup_1", "a"))
+    thread = threading.Thread(target=lambda: outcomes.append(machine(blackboard)))
+    thread.start()
+    assert robot.navigation.started.wait(5.0)
+    machine.cancel_state()
+    thread.join(5.0)
+    assert outcomes == [CANCEL] and robot.navigation.cancelled.is_set()
+
+
+@pytest.fixture
+def scene() -> FakeRobot:
+    robot = make_robot()
+    robot.navigation.pose = Pose2D(2.0, 0.0, 0.0)
+    robot.store.objects.save(PddlObject("cup_1", "cup"))
+    robot.anchoring.add("cup_1", "cup", (2.5, 0.0, 0.75))
+    return robot
+
+
+def bring(robot: FakeRobot, *objects: str) -> tuple[str, dict]:
+    blackboard = BRING_ACTION.blackboard_for(objects)
+    outcome = BRING_ACTION.make_state_machine(robot.context)(blackboard)
+    return outcome, dict(blackboard)
+
+
+def test_bring_picks_expects_carried_carries_places_and_expects_it_there(scene: FakeRobot) -> None:
+    scene.navigation.on_arrival.append(
+        lambda pose: scene.anchoring.see("cup_1") if scene.grasp.places else None)  # seen once put down
+    outcome, blackboard = bring(scene, "cup_1", "b", "c")
+    assert outcome == SUCCEED, blackboard.get(REASON_KEY)
+    assert scene.grasp.picks == [("cup", (2.5, 0.0, 0.75))]
+    carried, placed = scene.anchoring.expectations
+    assert (carried.kind, carried.symbol, carried.position, carried.source) == (
+        "carried", "cup_1", FAST.carry_offset, BRING_SOURCE)
+    assert (placed.kind, placed.place, placed.source) == ("at", "c", BRING_SOURCE)
+    assert scene.grasp.places == [placed.position]
+    assert placed.position == pytest.approx((5.5, 0.0, 0.75))  # half a metre ahead, facing east
+    assert [(g.x, g.y) for g in scene.navigation.goals] == [(2.0, 0.0), (5.0, 0.0)]
+
+
+def test_bring_warns_when_the_placed_object_is_not_seen_but_still_succeeds(scene: FakeRobot) -> None:
+    outcome, blackboard = bring(scene, "cup_1", "b", "c")
+    assert outcome == SUCCEED
+    assert any("not seen there" in warning for warning in blackboard[WARNINGS_KEY])
+
+
+def test_bring_aborts_when_the_pick_fails(scene: FakeRobot) -> None:
+    scene.grasp.pick_result = GraspResult(False, "nothing to pick within 0.5 m")
+    outcome, blackboard = bring(scene, "cup_1", "b", "c")
+    assert outcome == ABORT and "could not pick cup_1 (cup)" in blackboard[REASON_KEY]
+    assert "nothing to pick within 0.5 m" in blackboard[REASON_KEY]
+    assert scene.anchoring.expectations == [] and len(scene.navigation.goals) == 1
+
+
+def test_bring_aborts_when_the_anchoring_layer_is_down_before_it_starts(scene: FakeRobot) -> None:
+    scene.anchoring.down = True
+    outcome, blackboard = bring(scene, "cup_1", "b", "c")
+    assert outcome == ABORT and "is the anchoring node running" in blackboard[REASON_KEY]
+    assert scene.grasp.picks == []
+
+
+def test_a_finished_search_can_run_again_with_a_fresh_blackboard() -> None:
+    robot = make_robot(BehaviorConfig(look_around_turns=0, look_dwell=0.0, reacquire_timeout=0.0, poll_period=0.01))
+    robot.anchoring.add("cup_1", "cup", (0.1, 0.0, 0.8), AnchorState.MISSING)
+    machine = FIND_OBJECT_ACTION.make_state_machine(robot.context)
+    assert machine(FIND_OBJECT_ACTION.blackboard_for(("cup_1", "a"))) == ABORT
+    robot.world["cup_1"] = (0.1, 0.0)
+    assert machine(FIND_OBJECT_ACTION.blackboard_for(("cup_1", "a"))) == SUCCEED
