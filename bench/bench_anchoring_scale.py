@@ -9,7 +9,7 @@ the rule matcher (the network's cost depends on the pairs that pass the gate, no
 bench_matching.py). Targets: per-frame cost flat within 2x from 100 to 10,000 far anchors;
 <= 300 MB for 10,000 anchors. One thread. Nothing is asserted.
 
-Run: python bench/bench_anchoring_scale.py
+Run: python bench/bench_anchoring_scale.py [--quick] [--json PATH]
 """
 
 # ruff: noqa: E402 - the thread limits must be set before NumPy and torch are imported
@@ -27,7 +27,9 @@ import tracemalloc
 
 import numpy as np
 import torch
-from bench_matching import FEATURE_DIMENSION, GALLERY_VIEWS, machine_description
+from bench_matching import FEATURE_DIMENSION, GALLERY_VIEWS
+from harness import script
+from harness.results import BenchmarkResult, LinePlot, Table
 
 from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, CameraView, LifecycleConfig, Percept
 from merlin2_sailor.anchoring.percept import BoundingBox2D
@@ -76,7 +78,7 @@ def new_anchoring() -> Anchoring:
     return Anchoring(AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=GALLERY_VIEWS)))
 
 
-def frame_cost_ms(far_anchors: int, rng: np.random.Generator) -> tuple[float, int]:
+def frame_cost_ms(far_anchors: int, rng: np.random.Generator, frames: int = FRAMES) -> tuple[float, int]:
     anchoring = new_anchoring()
     stamp = acquire_far_anchors(anchoring, far_anchors, rng)
     local_positions = np.column_stack(
@@ -85,7 +87,7 @@ def frame_cost_ms(far_anchors: int, rng: np.random.Generator) -> tuple[float, in
     local_embeddings = rng.random((LOCAL_OBJECTS, FEATURE_DIMENSION), dtype=np.float32)
     view = CameraView(INTRINSICS, CAMERA, np.full((INTRINSICS.height, INTRINSICS.width), 5.0, dtype=np.float32))
     times = []
-    for frame in range(FRAMES + 5):
+    for frame in range(frames + 5):
         stamp += 1.0 / 15.0
         percepts = [
             percept(f"class_{i}", local_positions[i], local_embeddings[i], stamp, rng) for i in range(LOCAL_OBJECTS)
@@ -120,22 +122,48 @@ def resident_mb() -> float:
         return int(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
-def main() -> None:
+def run(quick: bool = False) -> BenchmarkResult:
     torch.set_num_threads(1)
     rng = np.random.default_rng(0)
-    print(machine_description())
-    print(f"{LOCAL_OBJECTS} percepts per frame near the camera, far anchors 30-230 m away, rule matcher, "
-          f"depth image {INTRINSICS.width}x{INTRINSICS.height}; median of {FRAMES} frames")
+    frames = 20 if quick else FRAMES
+    memory_count = 1_000 if quick else 10_000
+    counts = (100, 1_000) if quick else (100, 1_000, 10_000)
+    result = BenchmarkResult(
+        "anchoring_scale", "Anchoring per frame as anchors pile up far from the camera",
+        f"{LOCAL_OBJECTS} percepts per frame near the camera, plus far anchors 30-230 m away each seen "
+        f"{GALLERY_VIEWS} times (full {FEATURE_DIMENSION}-d galleries); rule matcher, depth image "
+        f"{INTRINSICS.width}x{INTRINSICS.height} for the occlusion test; median of {frames} frames; one thread. "
+        "The baseline is the same scene with the fewest far anchors: the frame loop should not pay for "
+        "anchors it cannot see.",
+        parameters={"frames": frames, "far_anchors": list(counts), "memory_anchors": memory_count},
+    )
     # memory first, while the process has not yet grown its heap: the RSS growth is then meaningful
-    traced, rss, anchors = memory_of_anchors(10_000, rng)
-    print(f"memory for {anchors:,} anchors with {GALLERY_VIEWS}-view {FEATURE_DIMENSION}-d galleries: "
-          f"{traced:.0f} MB traced, {rss:.0f} MB RSS growth (target <= 300 MB)")
-    costs = {}
-    for count in (100, 1_000, 10_000):
-        costs[count], total = frame_cost_ms(count, rng)
-        print(f"{count:>6} far objects ({total:>6} anchors in all): {costs[count]:6.2f} ms/frame")
-    print(f"slowest / fastest: {max(costs.values()) / min(costs.values()):.2f}x (target: within 2x)")
+    traced, rss, anchors = memory_of_anchors(memory_count, rng)
+    print(f"  memory for {anchors:,} anchors: {traced:.0f} MB traced, {rss:.0f} MB RSS growth", flush=True)
+    target_mb = 300.0 * memory_count / 10_000
+    result.figure(f"memory for {anchors:,} anchors (traced)", traced, "MB", target=f"<= {target_mb:.0f} MB",
+                  met=traced <= target_mb)
+    result.figure(f"memory for {anchors:,} anchors (RSS growth)", rss, "MB", target=f"<= {target_mb:.0f} MB",
+                  met=rss <= target_mb)
+    costs, rows = {}, []
+    for count in counts:
+        costs[count], total = frame_cost_ms(count, rng, frames)
+        rows.append([count, total, round(costs[count], 3)])
+        print(f"  {count:>6} far objects ({total:>6} anchors in all): {costs[count]:6.2f} ms/frame", flush=True)
+    spread = max(costs.values()) / min(costs.values())
+    result.figure(f"per frame with {counts[-1]:,} far anchors", costs[counts[-1]], "ms/frame",
+                  baseline=costs[counts[0]], baseline_name=f"{counts[0]} far anchors",
+                  target="within 2x of the baseline", met=spread <= 2.0)
+    result.tables.append(Table("per-frame cost vs far anchors", ["far objects", "anchors in all", "ms/frame"], rows))
+    result.line_plots.append(LinePlot(
+        "anchoring_scale", f"anchoring per frame, {LOCAL_OBJECTS} percepts near the camera", "far anchors",
+        "ms per frame", [float(c) for c in counts], {"Anchoring.process": [costs[c] for c in counts]}, log_x=True))
+    return result
+
+
+def main() -> int:
+    return script.main(run, __doc__)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -1,14 +1,13 @@
 """How long it takes to write a frame in which 1,000 anchors all moved into the SQLite store.
 
-Run ``python bench/bench_knowledge_sync.py``. It prints figures and asserts nothing. The batched
-path is KnowledgeSync (grounding + diff + one ``apply``); the baseline sends exactly the same
-changes one store call each, the way a node without batching would, so the ratio isolates the
-cost of one transaction per fact. Target for the batched path: 100 ms or less.
+Run ``python bench/bench_knowledge_sync.py [--anchors N] [--frames N] [--quick] [--json PATH]``.
+It prints figures and asserts nothing. The batched path is KnowledgeSync (grounding + diff + one
+``apply``); the baseline sends exactly the same changes one store call each, the way a node
+without batching would, so the ratio isolates the cost of one transaction per fact. Target for
+the batched path: 100 ms or less.
 """
 
 import argparse
-import os
-import platform
 import statistics
 import sys
 import tempfile
@@ -20,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from harness import script
+from harness.results import BenchmarkResult, Table
 
 from merlin2_sailor.knowledge import (
     Change,
@@ -101,36 +103,38 @@ def measure(
     return timings, change_count
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--anchors", type=int, default=1000)
-    parser.add_argument("--frames", type=int, default=5)
-    arguments = parser.parse_args()
-
-    print(
-        f"machine: {platform.platform()}, {platform.processor() or platform.machine()}, "
-        f"{os.cpu_count()} CPUs, Python {platform.python_version()}"
-    )
-    print(f"{arguments.anchors} anchors, every one moved in each of {arguments.frames} frames")
+def run(quick: bool = False, anchors: int = 0, frames: int = 0) -> BenchmarkResult:
+    anchor_count = anchors or (300 if quick else 1000)
+    frame_count = frames or (3 if quick else 5)
+    print(f"  {anchor_count} anchors, every one moved in each of {frame_count} frames", flush=True)
     with tempfile.TemporaryDirectory() as directory:
-        batched, changes = measure(
-            Path(directory), "batched", arguments.anchors, arguments.frames, None
-        )
-        naive, _ = measure(
-            Path(directory), "naive", arguments.anchors, arguments.frames, one_call_per_change
-        )
+        batched, changes = measure(Path(directory), "batched", anchor_count, frame_count, None)
+        naive, _ = measure(Path(directory), "naive", anchor_count, frame_count, one_call_per_change)
     batched_ms, naive_ms = statistics.median(batched), statistics.median(naive)
-    print(f"changes per frame: {changes}")
-    print(
-        f"batched (KnowledgeSync, one transaction): median {batched_ms:8.1f} ms, "
-        f"min {min(batched):.1f}, max {max(batched):.1f}  (target <= {TARGET_MILLISECONDS:.0f} ms)"
+    result = BenchmarkResult(
+        "knowledge_sync", "Knowledge-base sync of a frame: one batch vs one store call per change",
+        f"{anchor_count} anchors in the SQLite store, every one moved to another waypoint in each of {frame_count} "
+        f"frames ({changes} changes per frame); median per frame of planning plus writing. Ours: KnowledgeSync "
+        "(grounding, diff, one transaction). Baseline: exactly the same changes, one store call each.",
+        parameters={"anchors": anchor_count, "frames": frame_count, "changes_per_frame": changes},
     )
-    print(
-        f"naive (one store call per change):        median {naive_ms:8.1f} ms, "
-        f"min {min(naive):.1f}, max {max(naive):.1f}"
-    )
-    print(f"ratio naive / batched: {naive_ms / batched_ms:.1f}x")
+    result.figure(f"{anchor_count} anchors moved, batched", batched_ms, "ms/frame", baseline=naive_ms,
+                  baseline_name="one call per change", target=f"<= {TARGET_MILLISECONDS:.0f} ms",
+                  met=batched_ms <= TARGET_MILLISECONDS)
+    result.tables.append(Table("per frame", ["path", "median ms", "min ms", "max ms"], [
+        ["batched (one transaction)", round(batched_ms, 1), round(min(batched), 1), round(max(batched), 1)],
+        ["one store call per change", round(naive_ms, 1), round(min(naive), 1), round(max(naive), 1)],
+    ]))
+    return result
+
+
+def main() -> int:
+    def extend(parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--anchors", type=int, default=0, help="anchors (default 1000, quick 300)")
+        parser.add_argument("--frames", type=int, default=0, help="frames (default 5, quick 3)")
+
+    return script.main(run, __doc__, extend=extend)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

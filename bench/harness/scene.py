@@ -1,0 +1,87 @@
+"""A synthetic RGB-D frame with N objects in view, and its ground-truth detections.
+
+The pipeline benchmarks feed the real nodes without a detector, so the frame only has to look
+like a camera's to the percept generator: a 640x480 colour image, a registered 16UC1 depth image
+in millimetres (what a RealSense publishes) with a few pixels missing, a back wall, and N textured
+objects at 1.5-3.5 m laid out on a grid so that none hides another. Detections are the objects'
+true boxes with a pixel of noise per frame, as a detector's boxes wobble. ROS-free.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.perception.camera_model import CameraIntrinsics
+from merlin2_sailor.perception.detection import Detection
+from merlin2_sailor.perception.pose import Pose
+
+WIDTH, HEIGHT = 640, 480
+WALL_MILLIMETRES = 5000
+MISSING_DEPTH_FRACTION = 0.02
+BOX_NOISE_PIXELS = 1.0
+#: Everyday classes, most of them grounded to their own PDDL type by config/grounding.yaml.
+CLASS_NAMES = ("cup", "book", "bottle", "bowl", "teddy bear", "cell phone", "wine glass", "chair", "laptop", "vase")
+#: Camera 1 m above the map origin looking along world +x (optical z forward, x right, y down).
+CAMERA_TO_WORLD = Pose(np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]), np.array([0.0, 0.0, 1.0]))
+
+
+@dataclass(frozen=True)
+class SceneObject:
+    class_id: int
+    class_name: str
+    box: BoundingBox2D
+
+
+@dataclass(frozen=True)
+class Scene:
+    intrinsics: CameraIntrinsics
+    camera_to_world: Pose
+    color: np.ndarray  # (H, W, 3) uint8, RGB
+    depth_millimetres: np.ndarray  # (H, W) uint16, 0 where there is no measurement
+    objects: tuple[SceneObject, ...]
+
+
+def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int = HEIGHT) -> Scene:
+    """``object_count`` objects on a grid filling the image, each 60 % of its cell."""
+    if object_count < 1:
+        raise ValueError("a scene needs at least one object")
+    rng = np.random.default_rng(seed)
+    columns = math.ceil(math.sqrt(object_count * width / height))
+    rows = math.ceil(object_count / columns)
+    cell_width, cell_height = width / columns, height / rows
+    color = rng.integers(90, 140, (height, width, 3), dtype=np.uint8)
+    depth = (WALL_MILLIMETRES + rng.normal(0.0, 5.0, (height, width))).astype(np.uint16)
+    objects = []
+    for index in range(object_count):
+        row, column = divmod(index, columns)
+        centre_x = (column + 0.5 + rng.uniform(-0.1, 0.1)) * cell_width
+        centre_y = (row + 0.5 + rng.uniform(-0.1, 0.1)) * cell_height
+        box = BoundingBox2D(centre_x, centre_y, 0.6 * cell_width, 0.6 * cell_height)
+        x_min, y_min, x_max, y_max = (int(round(v)) for v in box.corners)
+        distance = rng.uniform(1500.0, 3500.0)
+        depth[y_min:y_max, x_min:x_max] = (distance + rng.normal(0.0, 5.0, (y_max - y_min, x_max - x_min))).astype(
+            np.uint16)
+        base = rng.integers(0, 256, 3)
+        texture = rng.integers(-40, 40, (y_max - y_min, x_max - x_min, 3))
+        color[y_min:y_max, x_min:x_max] = np.clip(base + texture, 0, 255).astype(np.uint8)
+        class_id = index % len(CLASS_NAMES)
+        objects.append(SceneObject(class_id, CLASS_NAMES[class_id], box))
+    depth[rng.random((height, width)) < MISSING_DEPTH_FRACTION] = 0
+    focal = 525.0 * width / 640.0
+    intrinsics = CameraIntrinsics(fx=focal, fy=focal, cx=(width - 1) / 2.0, cy=(height - 1) / 2.0,
+                                  width=width, height=height)
+    return Scene(intrinsics, CAMERA_TO_WORLD, color, depth, tuple(objects))
+
+
+def detections_of(scene: Scene, rng: np.random.Generator, noise: float = BOX_NOISE_PIXELS) -> list[Detection]:
+    """The objects' boxes with ``noise`` pixels of jitter, as a detector would report them."""
+    detections = []
+    for item in scene.objects:
+        dx, dy, dw, dh = rng.uniform(-noise, noise, 4)
+        box = BoundingBox2D(item.box.center_x + dx, item.box.center_y + dy, item.box.width + dw, item.box.height + dh)
+        detections.append(Detection(item.class_id, item.class_name, float(rng.uniform(0.7, 0.95)), box))
+    return detections
