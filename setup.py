@@ -21,7 +21,9 @@ NODE_ENTRY_POINTS = [
     "anchoring = merlin2_sailor.ros.anchoring_node:main",
     "detector = merlin2_sailor.ros.detector_node:main",
     "percept_generator = merlin2_sailor.ros.percept_node:main",
+    "world = merlin2_sailor_demos.world_node:main",
     "behaviors = merlin2_sailor_behaviors.ros.behaviors_node:main",
+    "mission = merlin2_sailor_behaviors.mission.mission_node:main",
 ]
 
 # Command-line tools.
@@ -49,7 +51,8 @@ setup(
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE_NAME}"]),
         (f"share/{PACKAGE_NAME}", ["package.xml"]),
-        (f"share/{PACKAGE_NAME}/config", glob("config/*")),
+        (f"share/{PACKAGE_NAME}/config", glob("config/*.*")),
+        (f"share/{PACKAGE_NAME}/config/worlds", glob("config/worlds/*.yaml")),
         (f"share/{PACKAGE_NAME}/launch", glob("launch/*")),
     ],
     package_data={"merlin2_sailor": ["models/*.pt", "models/*.json"]},
