@@ -66,8 +66,13 @@ class MissionNode(Node):
                 self, "behaviors_prefix", "/behaviors", "Where the behaviours' action servers are."),
             required_actions=tuple(name for name in required_actions if name),
         )
-        self._goals = parse_goals(goals)
         self.exit_code: int | None = None
+        if not any(goal.strip() for goal in goals):
+            # Nothing to do: say how to give it something, and idle until stopped.
+            self.get_logger().warning("no goals given (e.g. -p \"goals:=['robot_at(kitchen)']\"): idle")
+            self._worker = None
+            return
+        self._goals = parse_goals(goals)
         self._store = open_knowledge_base(location)
         self._session = MissionSession(self._store, self, config, self.get_logger().info)
         self._anchor_words = AnchorEventWording()
@@ -101,6 +106,9 @@ class MissionNode(Node):
                 self.get_logger().info(line)
 
     def destroy_node(self) -> None:
+        if self._worker is None:
+            super().destroy_node()
+            return
         self._session.cancel()
         self._worker.join(timeout=10.0)
         self._session.close()
