@@ -41,7 +41,7 @@ from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.resources import config_file
+from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions import (
     array_to_image,
     camera_info_message,
@@ -108,7 +108,7 @@ class WorldNode(Node):
                                              "Seconds between two status log lines; 0 disables them.",
                                              minimum=0.0, maximum=3600.0)
 
-        path = Path(world_file).expanduser() if world_file else config_file(DEFAULT_WORLD_FILE)
+        path = config_path(world_file, DEFAULT_WORLD_FILE)
         self._world = World(load_world(path), seed=seed, detector_noise=noise)
         self._max_speed = self._world.description.robot.limits.max_linear_speed
         self._lock = threading.Lock()

@@ -43,6 +43,19 @@ def config_file(name: str) -> Path:
     return path
 
 
+def config_path(value: str, default_name: str) -> Path:
+    """The file a node parameter names: a path; or, relative, one of the shipped config/ files
+    (``worlds/house_grounding.yaml``), so launch files need no absolute paths; or, empty,
+    config/<default_name>."""
+    if not value:
+        return config_file(default_name)
+    path = Path(value).expanduser()
+    if path.is_file() or path.is_absolute():
+        return path
+    shipped = share_directory() / "config" / value
+    return shipped if shipped.is_file() else path
+
+
 def find_launch_file(name_or_path: str) -> Path:
     """Accept a path to a launch file, or the name of one shipped in launch/ (with or without .yaml)."""
     path = Path(name_or_path).expanduser()

@@ -51,8 +51,8 @@ class MissionNode(Node):
         self._name = declare_parameter(self, "mission_name", "mission", "Name of the mission, for the logs.")
         location = declare_parameter(
             self, "knowledge_base", "ros:///merlin2", "Knowledge base to plan over (ros:///merlin2, sqlite://...).")
-        required_actions = declare_parameter(
-            self, "required_actions", [""], "Actions to wait for before planning ([''] waits for any).")
+        actions = declare_parameter(
+            self, "actions", [""], "Actions the mission may use, waited for before planning ([''] : every one).")
         config = SessionConfig(
             engine=declare_parameter(self, "engine", "aries", "unified-planning engine (aries, tamer, ...)."),
             planning_timeout=declare_parameter(
@@ -64,7 +64,7 @@ class MissionNode(Node):
                 minimum=1.0, maximum=3600.0),
             behaviors_prefix=declare_parameter(
                 self, "behaviors_prefix", "/behaviors", "Where the behaviours' action servers are."),
-            required_actions=tuple(name for name in required_actions if name),
+            actions=tuple(name for name in actions if name),
         )
         self.exit_code: int | None = None
         if not any(goal.strip() for goal in goals):

@@ -38,14 +38,16 @@ class MissionUnavailable(SailorError):
 @dataclass(frozen=True)
 class SessionConfig:
     """Planning engine and limits; ``actions_timeout``: seconds to wait for the knowledge base to
-    answer and the behaviours' actions and servers to appear."""
+    answer and the behaviours' actions and servers to appear; ``actions``: the actions the
+    mission may use (empty: every action registered), which is also a way to keep a satisficing
+    planner from wandering (an exploration has no business bringing cups around)."""
 
     engine: str = "aries"
     planning_timeout: float = 10.0
     max_replans: int = 3
     actions_timeout: float = 60.0
     behaviors_prefix: str = "/behaviors"
-    required_actions: tuple[str, ...] = ()
+    actions: tuple[str, ...] = ()
 
 
 class MissionSession:
@@ -73,13 +75,16 @@ class MissionSession:
         while not self._canceled.is_set():
             try:
                 actions = {action.name for action in self._store.actions.get_all()}
-                missing = sorted(set(self._config.required_actions) - actions)
+                missing = sorted(set(self._config.actions) - actions)
                 if actions and not missing:
                     behaviours = behaviours_for_store(
                         self._store, self._node, self._config.behaviors_prefix, discovery_timeout=2.0
                     )
-                    unserved = sorted(set(self._config.required_actions or actions) - set(behaviours))
+                    wanted = set(self._config.actions or actions)
+                    unserved = sorted(wanted - set(behaviours))
                     if not unserved:
+                        for name in set(behaviours) - wanted:
+                            behaviours.pop(name).destroy()
                         self._behaviours = behaviours
                         self._say(f"ready: actions {', '.join(sorted(behaviours))}")
                         return

@@ -5,7 +5,8 @@
 2. NAVIGATING: one NavigateToPose goal; cancelling the action cancels the goal.
 3. ANNOUNCING: on arrival, EXPECT_AT for each of those objects at its anchor's current position
    (place = destination, source = "navigation"), so Track checks them against what it sees.
-4. LOOKING_AROUND: turn in place through 360 degrees, so each is confirmed or marked missing.
+4. LOOKING_AROUND: turn in place through 360 degrees, so each is confirmed or marked missing;
+   skipped when nothing was announced (a first visit: exploring is the explore action's job).
 
 It succeeds once arrived: an object the knowledge base cannot list or the anchoring layer cannot
 hear about, or a turn that fails, is a warning, not a failed navigation (the robot is there).
@@ -32,6 +33,9 @@ from merlin2_sailor_behaviors.state_machines import ABORT, CANCEL, SUCCEED, Blac
 NAVIGATION_SOURCE = "navigation"
 """The ``source`` of the expectations navigation announces."""
 
+LOOK = "look"
+"""ANNOUNCING's outcome when it announced something the camera must now check."""
+
 TARGET_KEY = "navigation.target"
 EXPECTED_KEY = "navigation.expected_objects"
 
@@ -52,7 +56,7 @@ def announce_expected(state: BehaviorState, blackboard: Blackboard) -> str:
     destination = blackboard["destination"]
     symbols = blackboard[EXPECTED_KEY]
     if not symbols:
-        return SUCCEED
+        return SUCCEED  # nothing to check: done
     context = state.context
     try:
         anchors = {anchor.symbol: anchor for anchor in context.anchoring.get_anchors()}
@@ -68,7 +72,7 @@ def announce_expected(state: BehaviorState, blackboard: Blackboard) -> str:
             context.anchoring.expect_at(symbol, anchor.position, destination, NAVIGATION_SOURCE)
         except BehaviorError as error:
             warn(context, blackboard, f"cannot announce {symbol} at {destination}: {error}")
-    return SUCCEED
+    return LOOK
 
 
 def navigation_state_machine(context: BehaviorContext) -> StateMachine:
@@ -76,7 +80,9 @@ def navigation_state_machine(context: BehaviorContext) -> StateMachine:
     machine = StateMachine(outcomes=[SUCCEED, ABORT, CANCEL])
     machine.add_state("PLANNING_ROUTE", CallbackState(context, plan_route), {SUCCEED: "NAVIGATING"})
     machine.add_state("NAVIGATING", GoTo(context, TARGET_KEY), {SUCCEED: "ANNOUNCING"})
-    machine.add_state("ANNOUNCING", CallbackState(context, announce_expected), {SUCCEED: "LOOKING_AROUND"})
+    machine.add_state(
+        "ANNOUNCING", CallbackState(context, announce_expected, (LOOK, SUCCEED, ABORT, CANCEL)), {LOOK: "LOOKING_AROUND"}
+    )
     machine.add_state("LOOKING_AROUND", LookAround(context, TARGET_KEY, required=False))
     return machine
 

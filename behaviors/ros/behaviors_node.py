@@ -33,7 +33,7 @@ from merlin2_sailor.errors import ConfigurationError, KnowledgeError
 from merlin2_sailor.knowledge import Change, KnowledgeBase, PddlObject
 from merlin2_sailor.knowledge.grounding import GroundingConfig
 from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
-from merlin2_sailor.resources import config_file
+from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS, select_actions
@@ -97,7 +97,7 @@ class BehaviorsNode(Node):
             "Declare robot_at(<nearest waypoint>) at start when the knowledge base has no robot_at fact.")
         config = self._behavior_config()
 
-        grounding_config = GroundingConfig.from_yaml(grounding or config_file("grounding.yaml"))
+        grounding_config = GroundingConfig.from_yaml(config_path(grounding, "grounding.yaml"))
         if grounding_config.location_type != LOCATION_TYPE:
             raise ConfigurationError(
                 f"the behaviours' domain uses waypoints of type {LOCATION_TYPE!r}, but the grounding's "

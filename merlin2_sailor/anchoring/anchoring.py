@@ -431,6 +431,8 @@ class Anchoring:
                 self._missing.add(anchor.symbol)
                 changes.missing.append(anchor)
                 changes.event(AnchorEventKind.MISSING, anchor.symbol, missed_frames=anchor.missed_frames)
+            elif anchor.missing_since is not None:
+                self._missing.add(anchor.symbol)  # a tentative anchor not seen where it should be: to forget
 
     def _expire_missing(self, changes: _Changes) -> None:
         for symbol in sorted(self._missing):
@@ -459,7 +461,7 @@ class Anchoring:
     def _insert(self, anchor: Anchor) -> None:
         self._index.add(anchor)
         self._by_class.setdefault(anchor.class_name, set()).add(anchor.symbol)
-        if anchor.state is AnchorState.MISSING:
+        if anchor.state is AnchorState.MISSING or anchor.missing_since is not None:
             self._missing.add(anchor.symbol)
         if anchor.expectation is not None:
             self._expected.add(anchor.symbol)

@@ -4,9 +4,10 @@ The original SAILOR kept every anchor forever and could not tell "not seen" from
 anchor earns trust by being seen (``confirm_after`` percepts), loses it only when it *should*
 have been seen (in the camera frustum and not occluded: the caller decides that) for
 ``missed_frames_to_missing`` consecutive frames, and is forgotten after ``forget_after`` seconds
-missing. Anchors never confirmed are forgotten sooner (``forget_tentative_after``): most of them
-are spurious detections, and keeping them would let false positives pile up. Reacquiring a
-missing anchor restores it.
+missing. Anchors never confirmed are forgotten sooner (``forget_tentative_after`` after they
+should have been seen and were not) and without ever being called missing: most of them are
+spurious detections, and announcing them as missing objects (to the knowledge base, to a planner)
+would let false positives pile up where they do harm. Reacquiring a missing anchor restores it.
 
 Each function changes one anchor and returns whether its state changed, so the caller emits the
 matching event.
@@ -62,14 +63,20 @@ def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
 
 
 def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleConfig) -> bool:
-    """Count one frame in which the anchor should have been seen; True when it became MISSING."""
+    """Count one frame in which the anchor should have been seen; True when it became MISSING.
+
+    A tentative anchor never becomes MISSING: it only starts the clock that forgets it.
+    """
     if anchor.state is AnchorState.MISSING:
         return False
     anchor.missed_frames += 1
     if anchor.missed_frames < config.missed_frames_to_missing:
         return False
+    if anchor.missing_since is None:
+        anchor.missing_since = stamp
+    if anchor.state is AnchorState.TENTATIVE:
+        return False
     anchor.state = AnchorState.MISSING
-    anchor.missing_since = stamp
     return True
 
 
@@ -79,7 +86,9 @@ def expire(anchor: Anchor, stamp: float, config: LifecycleConfig) -> bool:
     An anchor with an active expectation is not expired: an action has said where it is, and
     only the camera (a retraction) may overrule that.
     """
-    if anchor.state is not AnchorState.MISSING or anchor.missing_since is None or anchor.expectation is not None:
+    if anchor.state not in (AnchorState.MISSING, AnchorState.TENTATIVE):
+        return False
+    if anchor.missing_since is None or anchor.expectation is not None:
         return False
     limit = config.forget_after if was_confirmed(anchor, config) else config.forget_tentative_after
     if stamp - anchor.missing_since < limit:

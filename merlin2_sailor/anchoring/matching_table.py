@@ -14,7 +14,7 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    and anchors keep galleries of past embeddings, never re-embedded;
 3. **tracker continuity, decided by one rule**: a percept whose (non-empty) tracker id continues
    exactly one CONFIRMED anchor of the same class, last seen at most ``continuation_maximum_age``
-   ago and not gated, is taken as that anchor's continuation: its other pairs are not scored
+   ago, not gated and at most ``continuation_maximum_distance`` from it, is taken as that anchor's continuation: its other pairs are not scored
    (which is what spares its crop from the backbone) and the pair scores
    ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
    floor; a class mismatch never is;
@@ -56,7 +56,10 @@ class MatchingTableConfig:
     of one class often share); ``gate_class_mismatch``: never pair different classes;
     ``tracker_continuity_score``: the floor for a pair continuing a tracker id;
     ``continuation_maximum_age`` (s): how recent a continued anchor must be to skip scoring
-    (about a tracker's buffer); ``gated_score``: the penalty gated pairs hold (negative);
+    (about a tracker's buffer); ``continuation_maximum_distance`` (m): how far from a continued
+    anchor a percept may be for its tracker id to count at all (a 2D tracker swaps ids between
+    nearby objects of one class when the camera turns fast: an id that lands half a metre or more
+    away is a swap, not the same object); ``gated_score``: the penalty gated pairs hold (negative);
     ``search_score_cap``: the most a pair with an anchor being searched for (an expectation with a
     radius) can score, below an in-place match and a tracker continuation, so that a look-alike
     anchored where the search looks keeps its own percept."""
@@ -67,6 +70,7 @@ class MatchingTableConfig:
     gate_class_mismatch: bool = True
     tracker_continuity_score: float = 0.9
     continuation_maximum_age: float = 1.0
+    continuation_maximum_distance: float = 0.5
     gated_score: float = -1.0
     search_score_cap: float = 0.7
 
@@ -89,6 +93,11 @@ class MatchingTableConfig:
             )
         if not (0.0 < self.search_score_cap <= 1.0):
             raise ConfigurationError(f"table search_score_cap must be in (0, 1], got {self.search_score_cap}.")
+        if not (math.isfinite(self.continuation_maximum_distance) and self.continuation_maximum_distance > 0.0):
+            raise ConfigurationError(
+                f"table continuation_maximum_distance must be a positive number of metres, "
+                f"got {self.continuation_maximum_distance}."
+            )
         if not self.gated_score < 0.0:
             raise ConfigurationError(f"table gated_score must be negative (below any score), got {self.gated_score}.")
 
@@ -143,6 +152,13 @@ class MatchingTableBuilder:
 
         same_class = columns.class_names[:, np.newaxis] == anchor_columns.class_names[np.newaxis, :]
         continuations = tracker_continuations(columns.tracker_ids, anchor_columns.tracker_ids) & same_class & ~gated
+        candidate_rows, candidate_columns = np.nonzero(continuations)
+        if candidate_rows.size:
+            jump = np.linalg.norm(
+                columns.positions[candidate_rows] - anchor_columns.positions[candidate_columns], axis=1
+            )
+            too_far = jump > self.config.continuation_maximum_distance
+            continuations[candidate_rows[too_far], candidate_columns[too_far]] = False
         confirmed = np.array([anchor.state is AnchorState.CONFIRMED for anchor in anchors], dtype=bool)
         age = columns.stamps[:, np.newaxis] - anchor_columns.last_seen[np.newaxis, :]
         eligible = continuations & confirmed[np.newaxis, :] & (age <= self.config.continuation_maximum_age)

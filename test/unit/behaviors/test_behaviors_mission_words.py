@@ -39,6 +39,7 @@ def test_fact_changes_are_worded_with_their_provenance():
                     Proposition("object_at", ("cup_2", "bedroom"), provenance=Provenance.PERCEIVED)),
         ChangeEvent(Operation.DELETE, ItemKind.PROPOSITION, Proposition("object_at", ("cup_2", "kitchen"))),
         ChangeEvent(Operation.SAVE, ItemKind.PROPOSITION, Proposition("robot_near", ("cup_2",), is_goal=True)),
+        ChangeEvent(Operation.SAVE, ItemKind.PROPOSITION, Proposition("visible", ("cup_2",))),
         ChangeEvent(Operation.SAVE, ItemKind.OBJECT, PddlObject("cup_2", "cup")),
     ]
     assert describe_fact_changes(events) == ["+ object_at(cup_2, bedroom)  [perceived]", "- object_at(cup_2, kitchen)"]
@@ -46,11 +47,15 @@ def test_fact_changes_are_worded_with_their_provenance():
 
 def test_anchor_events_worded_only_when_notable():
     wording = AnchorEventWording()
-    assert wording.describe("acquired", "cup_2", "cup") == "anchor cup_2 (cup) acquired"
+    assert wording.describe("acquired", "cup_2", "cup") is None  # tentative: maybe a false positive
+    assert wording.describe("confirmed", "cup_2", "cup") == "anchor cup_2 (cup) anchored"
     assert wording.describe("reacquired", "cup_2") is None  # seen again a frame later: routine
     assert wording.describe("missing", "cup_2", "cup") == "anchor cup_2 (cup) missing"
     assert wording.describe("reacquired", "cup_2") == "anchor cup_2 reacquired after being missing"
     assert wording.describe("reacquired", "cup_2") is None
+    assert wording.describe("confirmed", "cup_2", reason="expectation") == "anchor cup_2 confirmed where expected"
     assert wording.describe("retracted", "cup_1", reason="expected place seen empty") == (
         "anchor cup_1 retracted: expected place seen empty"
     )
+    assert wording.describe("forgotten", "bird_9", reason="missing too long") is None  # never confirmed
+    assert wording.describe("forgotten", "cup_2", "cup", "requested") == "anchor cup_2 (cup) forgotten: requested"

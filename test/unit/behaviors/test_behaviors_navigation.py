@@ -67,6 +67,12 @@ def test_navigation_faces_the_way_it_arrives_or_the_waypoints_own_heading(robot:
     assert robot.navigation.goals[0].yaw == pytest.approx(math.pi / 2)  # driving north from b to d
 
 
+def test_navigation_to_a_place_with_nothing_to_check_does_not_look_around(robot: FakeRobot) -> None:
+    robot.navigation.pose = Pose2D(0.0, 0.0, 0.0)
+    assert run(robot, NAVIGATION_ACTION, "a", "b")[0] == SUCCEED
+    assert len(robot.navigation.goals) == 1 and robot.anchoring.expectations == []
+
+
 def test_navigation_to_an_unknown_waypoint_aborts_with_a_clear_message(robot: FakeRobot) -> None:
     outcome, blackboard = run(robot, NAVIGATION_ACTION, "a", "attic")
     assert outcome == ABORT
