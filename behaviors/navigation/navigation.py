@@ -81,7 +81,9 @@ def navigation_state_machine(context: BehaviorContext) -> StateMachine:
     machine.add_state("PLANNING_ROUTE", CallbackState(context, plan_route), {SUCCEED: "NAVIGATING"})
     machine.add_state("NAVIGATING", GoTo(context, TARGET_KEY), {SUCCEED: "ANNOUNCING"})
     machine.add_state(
-        "ANNOUNCING", CallbackState(context, announce_expected, (LOOK, SUCCEED, ABORT, CANCEL)), {LOOK: "LOOKING_AROUND"}
+        "ANNOUNCING",
+        CallbackState(context, announce_expected, (LOOK, SUCCEED, ABORT, CANCEL)),
+        {LOOK: "LOOKING_AROUND"},
     )
     machine.add_state("LOOKING_AROUND", LookAround(context, TARGET_KEY, required=False))
     return machine

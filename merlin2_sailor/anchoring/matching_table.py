@@ -14,7 +14,8 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    and anchors keep galleries of past embeddings, never re-embedded;
 3. **tracker continuity, decided by one rule**: a percept whose (non-empty) tracker id continues
    exactly one CONFIRMED anchor of the same class, last seen at most ``continuation_maximum_age``
-   ago, not gated and at most ``continuation_maximum_distance`` from it, is taken as that anchor's continuation: its other pairs are not scored
+   ago, not gated and at most ``continuation_maximum_distance`` from it, is taken as that
+   anchor's continuation: its other pairs are not scored
    (which is what spares its crop from the backbone) and the pair scores
    ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
    floor; a class mismatch never is;

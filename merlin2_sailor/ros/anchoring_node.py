@@ -36,13 +36,13 @@ from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.state_file import AnchoringStateFile
 from merlin2_sailor.anchoring.symbols import SymbolCounter
 from merlin2_sailor.anchoring.visibility import CameraView
-from merlin2_sailor.errors import ConfigurationError, SailorError
+from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
 from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
 from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.perception.stamped_buffer import StampedBuffer
-from merlin2_sailor.resources import config_file
+from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions import (
     camera_info_to_intrinsics,
     depth_to_metres,
@@ -59,6 +59,9 @@ from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
 
 NODE_NAME = "anchoring"
+#: Percepts stamped further than this ahead of the node's clock are refused: a camera clock gone
+#: wrong would otherwise expire every missing anchor at once ("missing since decades").
+FUTURE_STAMP_LIMIT_SECONDS = 10.0
 
 
 class AnchoringNode(Node):
@@ -130,7 +133,7 @@ class AnchoringNode(Node):
 
         self._worker = PersistenceWorker(
             self._copy_anchors, self._state_file, self._knowledge_base_opener(knowledge_base),
-            Grounding(GroundingConfig.from_yaml(grounding_file or config_file("grounding.yaml"))),
+            Grounding(GroundingConfig.from_yaml(config_path(grounding_file, "grounding.yaml"))),
             # Restored anchors are this node's objects in the knowledge base, saved as owned or not.
             owned_objects=(saved.owned_objects if saved else frozenset())
             | {anchor.symbol for anchor in self._anchoring.anchors},
@@ -180,7 +183,15 @@ class AnchoringNode(Node):
         return symbol
 
     def _log(self, level: str, message: str) -> None:
-        getattr(self.get_logger(), level)(message)
+        # One call site per severity: rclpy raises ValueError when one line logs at two severities,
+        # which after a knowledge-base outage failed every persistence step (nothing saved again).
+        logger = self.get_logger()
+        if level == "error":
+            logger.error(message)
+        elif level == "warning":
+            logger.warning(message)
+        else:
+            logger.info(message)
 
     # Inputs.
 
@@ -213,6 +224,7 @@ class AnchoringNode(Node):
     def _on_percepts(self, message: PerceptArray) -> None:
         stamp = stamp_to_seconds(message.header.stamp)
         try:
+            self._refuse_future_stamps(stamp, message)
             percepts = percepts_from_message(message)
             with self._lock:
                 result = self._anchoring.process(percepts, self._camera_view(stamp), stamp)
@@ -221,6 +233,14 @@ class AnchoringNode(Node):
                                       throttle_duration_sec=5.0)
             return
         self._publish(result)
+
+    def _refuse_future_stamps(self, stamp: float, message: PerceptArray) -> None:
+        latest = max([stamp, *(stamp_to_seconds(percept.stamp) for percept in message.percepts)])
+        lead = latest - self.get_clock().now().nanoseconds * 1e-9
+        if lead > FUTURE_STAMP_LIMIT_SECONDS:
+            raise InvalidInputError(
+                f"stamped {lead:.0f} s ahead of this node's clock (more than {FUTURE_STAMP_LIMIT_SECONDS:g} s); "
+                "synchronise the clocks of the camera and this computer")
 
     def _camera_view(self, stamp: float) -> CameraView | None:
         """The camera as it was at ``stamp``; without it no anchor is judged missing."""
@@ -290,11 +310,15 @@ class AnchoringNode(Node):
             return response
         near = (np.array([request.point.x, request.point.y, request.point.z])
                 if request.use_point else None)
-        with self._lock:
-            found: Anchor | None = self._anchoring.find(
-                symbol=request.symbol or None, class_name=request.class_name or None, near=near)
-            if found is not None:
-                response.anchor = anchors_to_message([found], Header()).anchors[0]
+        try:
+            with self._lock:
+                found: Anchor | None = self._anchoring.find(
+                    symbol=request.symbol or None, class_name=request.class_name or None, near=near)
+                if found is not None:
+                    response.anchor = anchors_to_message([found], Header()).anchors[0]
+        except SailorError as error:  # a point that is not 3 finite numbers: refused, not a crash
+            response.message = str(error)
+            return response
         response.found = found is not None
         if found is None:
             response.message = f"no anchor for {request.symbol or request.class_name!r}"

@@ -47,6 +47,9 @@ IMAGE_TOPIC = "color/image_raw"
 DETECTIONS_TOPIC = "detections"
 EXTERNAL_DETECTIONS_TOPIC = "detections_in"
 WARNING_PERIOD_SECONDS = 5.0  # bad input is logged at most this often, whatever the camera rate
+#: Masks are rasterised at the size they claim: one claiming more pixels than any camera image is
+#: refused unread (2**31 x 2**31 raised MemoryError and killed the node; less would fill the memory).
+MAXIMUM_MASK_PIXELS = 8192 * 8192
 
 
 class NewestFrameMailbox:
@@ -175,6 +178,10 @@ class DetectorNode(Node):
         valid = []
         for detection in message.detections:
             try:
+                if detection.mask.data and detection.mask.height * detection.mask.width > MAXIMUM_MASK_PIXELS:
+                    raise InvalidInputError(
+                        f"detection '{detection.class_name}' has a mask of {detection.mask.width}x"
+                        f"{detection.mask.height} pixels, more than the {MAXIMUM_MASK_PIXELS} of any camera image")
                 detection_from_message(detection)
             except InvalidInputError as error:
                 self._invalid_detections += 1

@@ -36,6 +36,9 @@ from merlin2_sailor_interfaces.msg import KnowledgeChanges
 
 NODE_NAME = "knowledge_base"
 CHANGES_TOPIC = "knowledge_changes"
+#: A refusal is answered with its reason every time, but logged at most this often (a client
+#: retrying a bad request in a loop must not flood the log).
+WARNING_PERIOD_SECONDS = 5.0
 
 
 @dataclass(frozen=True)
@@ -163,7 +166,8 @@ class KnowledgeBaseNode(Node):
             response.success = True
         except SailorError as error:
             response.success, response.message = False, str(error)
-            self.get_logger().error(f"new_symbol for {request.class_name!r} refused: {error}")
+            self.get_logger().error(f"new_symbol for {request.class_name!r} refused: {error}",
+                                    throttle_duration_sec=WARNING_PERIOD_SECONDS)
         return response
 
     def _write(self, make_changes: Callable[[], list[Change]], response: Any,
@@ -173,11 +177,12 @@ class KnowledgeBaseNode(Node):
             events = self._store.apply(make_changes())
         except SailorError as error:
             response.success, response.message = False, str(error)
-            self.get_logger().warning(f"write refused: {error}")
+            self.get_logger().warning(f"write refused: {error}", throttle_duration_sec=WARNING_PERIOD_SECONDS)
             return response
         except Exception as error:  # a database failure must not take the node down
             response.success, response.message = False, f"the store failed: {error}"
-            self.get_logger().error(f"the store failed to apply a batch: {error!r}")
+            self.get_logger().error(f"the store failed to apply a batch: {error!r}",
+                                    throttle_duration_sec=WARNING_PERIOD_SECONDS)
             return response
         response.success = True
         if keep_events:

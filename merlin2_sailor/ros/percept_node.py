@@ -72,6 +72,13 @@ from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray
 
 NODE_NAME = "percept_generator"
 WARNING_PERIOD_SECONDS = 5.0  # bad input is logged at most this often, whatever the camera rate
+#: Messages stamped further than this ahead of the node's clock are refused: the synchroniser
+#: drops everything older than the last set it emitted, so one frame from a clock that jumped
+#: ahead would otherwise silence the node until the real time caught up with it.
+FUTURE_STAMP_LIMIT_SECONDS = 10.0
+#: Masks are rasterised at the size they claim: one claiming more pixels than any camera image is
+#: refused unread (2**31 x 2**31 raised MemoryError and killed the node; less would fill the memory).
+MAXIMUM_MASK_PIXELS = 8192 * 8192
 #: Detection arrays whose stamps estimate the tracker's frame rate when it is not configured.
 RATE_ESTIMATION_FRAMES = 5
 #: The optical frame at the robot base's origin looking forward: REP 103 base (x forward, z up).
@@ -251,6 +258,8 @@ class PerceptNode(Node):
 
     def _on_detections(self, message: DetectionArray) -> None:
         try:
+            self._refuse_future_stamp(message.header)  # before the tracker sees the stamp
+            _refuse_oversized_masks(message)
             detections = detections_from_message(message)
         except InvalidInputError as error:
             self._warn("detections", f"detections dropped: {error}")
@@ -266,6 +275,7 @@ class PerceptNode(Node):
     def _push(self, input_name: str, header: Header, convert: Callable[[], Any]) -> None:
         """Convert a message and hand it to the synchroniser; a bad message is logged and dropped."""
         try:
+            self._refuse_future_stamp(header)
             value = convert()
             matched = self._synchroniser.push(input_name, stamp_to_seconds(header.stamp), value)
         except InvalidInputError as error:
@@ -273,6 +283,14 @@ class PerceptNode(Node):
             return
         if matched is not None:
             self._process(matched)
+
+    def _refuse_future_stamp(self, header: Header) -> None:
+        lead = stamp_to_seconds(header.stamp) - self._now()
+        if lead > FUTURE_STAMP_LIMIT_SECONDS:
+            raise InvalidInputError(
+                f"stamped {lead:.0f} s ahead of this node's clock (more than {FUTURE_STAMP_LIMIT_SECONDS:g} s); "
+                "check the camera driver's clock"
+            )
 
     # --- tracking -------------------------------------------------------------------------------
 
@@ -381,6 +399,16 @@ class PerceptNode(Node):
 
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
+
+
+def _refuse_oversized_masks(message: DetectionArray) -> None:
+    for detection in message.detections:
+        mask = detection.mask
+        if mask.data and mask.height * mask.width > MAXIMUM_MASK_PIXELS:
+            raise InvalidInputError(
+                f"detection '{detection.class_name}' has a mask of {mask.width}x{mask.height} pixels, "
+                f"more than the {MAXIMUM_MASK_PIXELS} of any camera image"
+            )
 
 
 def _make_tf_listener(node: Node) -> tuple[Any, Any]:
