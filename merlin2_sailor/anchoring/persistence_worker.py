@@ -87,10 +87,17 @@ class PersistenceWorker:
             self._store.close()
 
     def step(self, force_save: bool = False) -> None:
-        """One round: sync the knowledge base, and save the state file when due."""
+        """One round: sync the knowledge base, and save the state file when due.
+
+        A sync that created objects forces the save: until the state file holds those anchors
+        and says the objects are ours, a crash would leave them in the knowledge base for good
+        while the restarted node anchored the same things again under new symbols.
+        """
         anchors = self._copy_anchors()
+        owned_before = self._owned
         self._sync_knowledge_base(anchors.views)
-        if force_save or time.monotonic() >= self._next_save:
+        created = not self._owned <= owned_before
+        if force_save or created or time.monotonic() >= self._next_save:
             self._save(anchors)
 
     def _save(self, anchors: AnchorsCopy) -> None:

@@ -113,3 +113,18 @@ def test_stop_saves_the_anchors_even_when_the_knowledge_base_breaks_unexpectedly
     worker.stop()
     assert state.load().snapshot == {"anchors": ["cup_1"]}
     assert "error" in logs
+
+
+def test_a_sync_that_creates_objects_saves_the_state_at_once(tmp_path) -> None:
+    """A crash right after the knowledge base got a new object must not orphan it."""
+    kb = FlakyStore()
+    anchors = [anchor("cup_1", 1.0)]
+    state = AnchoringStateFile(tmp_path)
+    worker = PersistenceWorker(lambda: AnchorsCopy(views_of(anchors), lambda: {"anchors": [a.symbol for a in anchors]}),
+                               state, kb.open, GROUNDING, save_period=3600.0)
+    worker.step()  # the first step is due anyway
+    anchors.append(anchor("book_1", 1.2))
+    worker.step()  # long before the next periodic save
+    assert "book_1" in state.load().owned_objects
+    worker.step()  # nothing new: no save needed (and none made: the file is unchanged)
+    assert len(state.load().snapshot["anchors"]) == 2
