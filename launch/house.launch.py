@@ -22,7 +22,7 @@ def generate_launch_description() -> LaunchDescription:
                                    report_folder=data),
              output="screen"),
         Node(package="merlin2_sailor", executable="percept_generator", namespace="camera",
-             parameters=parameters("percept_generator"), output="screen"),
+             parameters=parameters("percept_generator", maximum_depth=4.5), output="screen"),
         Node(package="merlin2_sailor", executable="knowledge_base", namespace="merlin2",
              parameters=parameters("knowledge_base", store=f"sqlite://{data}/knowledge.db"), output="screen"),
         Node(package="merlin2_sailor", executable="anchoring",

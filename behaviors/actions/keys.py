@@ -2,13 +2,11 @@
 
 Each PDDL parameter is a key of its own, holding its object's name (``blackboard["destination"]
 == "kitchen"``), as the dispatcher writes them; :data:`PLAN_STEP_KEY` holds the whole step. The
-keys below are the rest of the contract.
+keys below are the rest of the contract; :data:`REASON_KEY` (why a behaviour did not succeed, in
+words, written by the state that aborted) is read by the dispatcher too.
 """
 
-from merlin2_sailor_behaviors.planning.dispatcher import PLAN_STEP_KEY
-
-REASON_KEY = "reason"
-"""Why the behaviour did not succeed, in words: written by the state that aborted."""
+from merlin2_sailor_behaviors.planning.dispatcher import PLAN_STEP_KEY, REASON_KEY
 
 WARNINGS_KEY = "warnings"
 """Things that went wrong without stopping the behaviour (a list of sentences)."""

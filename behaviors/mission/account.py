@@ -49,9 +49,13 @@ class AnchorEventWording:
         kind = kind.lower()
         what = f" ({class_name})" if class_name else ""
         why = f": {reason}" if reason else ""
-        if symbol in self._missing and kind in ("reacquired", "confirmed"):
+        if symbol in self._missing and kind == "confirmed":
+            if reason == "expectation":
+                return f"anchor {symbol}{what} seen where it was searched for"
             self._missing.discard(symbol)
             return f"anchor {symbol}{what} reacquired after being missing"
+        if kind == "reacquired":
+            return None  # routine, or a first sighting of a missing anchor: not back until confirmed
         if kind == "confirmed":
             if symbol in self._confirmed:
                 return f"anchor {symbol}{what} confirmed where expected" if reason == "expectation" else None

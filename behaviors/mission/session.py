@@ -26,7 +26,7 @@ from merlin2_sailor_behaviors.planning import (
     Planner,
     PlannerConfig,
 )
-from merlin2_sailor_behaviors.ros.pddl_action_client import PddlActionBehaviour, behaviours_for_store
+from merlin2_sailor_behaviors.ros.pddl_action_client import PddlActionBehaviour
 
 Say = Callable[[str], None]
 
@@ -64,36 +64,38 @@ class MissionSession:
         self._say = say
         self._planner = Planner(PlannerConfig(engine=config.engine, timeout_seconds=config.planning_timeout))
         self._behaviours: dict[str, PddlActionBehaviour] = {}
+        self._clients: dict[str, PddlActionBehaviour] = {}
         self._runner: MissionRunner | None = None
         self._lock = threading.Lock()
         self._canceled = threading.Event()
 
     def wait_until_ready(self) -> None:
-        """Wait for the knowledge base and the behaviours' actions and servers."""
+        """Wait for the knowledge base and the behaviours' actions and servers.
+
+        Each action's client is made once and kept until :meth:`close`: destroying an rclpy
+        action client while another thread spins its node can crash that executor.
+        """
         deadline = time.monotonic() + self._config.actions_timeout
         last_problem = "nothing checked yet"
         while not self._canceled.is_set():
             try:
-                actions = {action.name for action in self._store.actions.get_all()}
-                missing = sorted(set(self._config.actions) - actions)
-                if actions and not missing:
-                    behaviours = behaviours_for_store(
-                        self._store, self._node, self._config.behaviors_prefix, discovery_timeout=2.0
-                    )
-                    wanted = set(self._config.actions or actions)
-                    unserved = sorted(wanted - set(behaviours))
+                registered = {action.name for action in self._store.actions.get_all()}
+                wanted = set(self._config.actions or registered)
+                unregistered = sorted(wanted - registered)
+                if wanted and not unregistered:
+                    for name in wanted - set(self._clients):
+                        self._clients[name] = PddlActionBehaviour(
+                            self._node, name, f"{self._config.behaviors_prefix.rstrip('/')}/{name}")
+                    unserved = sorted(name for name in wanted if not self._clients[name].server_is_ready())
                     if not unserved:
-                        for name in set(behaviours) - wanted:
-                            behaviours.pop(name).destroy()
-                        self._behaviours = behaviours
-                        self._say(f"ready: actions {', '.join(sorted(behaviours))}")
+                        self._behaviours = {name: self._clients[name] for name in sorted(wanted)}
+                        self._say(f"ready: actions {', '.join(self._behaviours)}")
                         return
-                    for behaviour in behaviours.values():
-                        behaviour.destroy()
                     last_problem = f"no server yet for {', '.join(unserved)}"
                 else:
                     last_problem = (
-                        f"actions {', '.join(missing)} not registered yet" if missing else "no action registered yet"
+                        f"actions {', '.join(unregistered)} not registered yet" if unregistered
+                        else "no action registered yet"
                     )
             except KnowledgeError as error:
                 last_problem = f"the knowledge base does not answer ({error})"
@@ -135,9 +137,11 @@ class MissionSession:
             runner.cancel()
 
     def close(self) -> None:
+        """Cancel what runs and destroy the action clients: call it once the node no longer spins."""
         self.cancel()
-        for behaviour in self._behaviours.values():
-            behaviour.destroy()
+        for client in self._clients.values():
+            client.destroy()
+        self._clients = {}
         self._behaviours = {}
 
 

@@ -48,6 +48,9 @@ Behaviour = Callable[[Blackboard], str]
 """What runs a step: a state or state machine (called with the blackboard), or any callable
 returning succeeded / aborted / canceled. If it has ``cancel_state()``, the runtime uses it."""
 
+REASON_KEY = "reason"
+"""Blackboard key where a behaviour that did not succeed may say why, in words."""
+
 PLAN_STEP_KEY = "plan_step"
 """Blackboard key of the :class:`PlanStep` being run; each parameter is also a key, holding the
 name of its object (``blackboard["destination"] == "kitchen"``)."""
@@ -238,7 +241,8 @@ class Dispatcher:
             with self._lock:
                 self._running_behaviour = None
                 self._running_needs = frozenset()
-        _logger.info("%s %s", step.step, outcome)
+        reason = blackboard[REASON_KEY] if outcome != SUCCEED and REASON_KEY in blackboard else ""
+        _logger.info("%s %s%s", step.step, outcome, f": {reason}" if reason else "")
         if outcome == SUCCEED:
             self._write(lambda: self._effects.apply(step.end_effects))
             return _Run(_Ending.DONE)

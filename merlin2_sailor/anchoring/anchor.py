@@ -19,7 +19,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
-from merlin2_sailor.anchoring.gallery import add_to_gallery
+from merlin2_sailor.anchoring.gallery import add_to_gallery, from_bfloat16_bits
 from merlin2_sailor.anchoring.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
 
@@ -64,6 +64,8 @@ class Anchor:
     """Reacquired or acquired in the latest processed frame."""
     missed_frames: int = 0
     """Consecutive frames in which it should have been visible and was not reacquired."""
+    recovery_sightings: int = 0
+    """Sightings since the anchor went missing; it is confirmed again after ``confirm_after``."""
     missing_since: float | None = None
     provenance: Provenance = Provenance.PERCEIVED
     """PERCEIVED when ``position`` comes from the camera, EXPECTED when from an action's effect."""
@@ -119,6 +121,28 @@ class Anchor:
         self.visible = True
         self.missed_frames = 0
         self.missing_since = None
+
+    def absorb_anchor(self, other: Anchor, config: FusionConfig) -> None:
+        """Merge: ``other`` turned out to be this object, seen again under a new symbol.
+
+        Its latest position is where the object is now (this anchor's older one is where it
+        was), its views join the gallery, and its sightings and class votes add to this one's.
+        """
+        self.position = other.position.copy()
+        self.position_variance = other.position_variance
+        self.perceived_position = other.perceived_position.copy()
+        self.size = other.size.copy()
+        for class_name, votes in other.class_votes.items():
+            self.class_votes[class_name] = self.class_votes.get(class_name, 0.0) + votes
+        self.class_name = winning_class(self.class_votes, self.class_name)
+        if other.gallery is not None:
+            for view in from_bfloat16_bits(other.gallery):
+                self.gallery = add_to_gallery(self.gallery, view, config.gallery_size)
+        self.times_seen += other.times_seen
+        self.last_seen = max(self.last_seen, other.last_seen)
+        self.last_tracker_id = other.last_tracker_id or self.last_tracker_id
+        self.visible = other.visible
+        self.provenance = Provenance.PERCEIVED
 
     @property
     def is_active(self) -> bool:

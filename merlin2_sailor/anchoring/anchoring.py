@@ -31,6 +31,7 @@ from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation, ExpectationKind
 from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.gallery import gallery_similarity
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_expected_but_unseen, after_sighting, expire
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.matching_table import Embedder, MatchingTableBuilder, MatchingTableConfig, with_embeddings
@@ -55,12 +56,15 @@ class AnchoringConfig:
     ``match_threshold``: the score a pair needs to reacquire (the paper's 0.5);
     ``world_frame``: the fixed frame percepts must be expressed in;
     ``expectation_tolerance`` (m): how close to an expected place a reacquired object must be
-    to confirm the expectation (farther retracts it).
+    to confirm the expectation (farther retracts it);
+    ``merge_similarity``: the cosine similarity of appearance galleries below which a search
+    never takes an anchor born while the sought one was missing as the sought one.
     """
 
     match_threshold: float = 0.5
     world_frame: str = "map"
     expectation_tolerance: float = 1.0
+    merge_similarity: float = 0.8
     table: MatchingTableConfig = field(default_factory=MatchingTableConfig)
     fusion: FusionConfig = field(default_factory=FusionConfig)
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
@@ -255,13 +259,29 @@ class Anchoring:
 
     # --- expected effects -------------------------------------------------------------------
 
-    def expect(self, symbol: str, expectation: Expectation, robot_pose: Pose | None = None) -> None:
+    def expect(
+        self, symbol: str, expectation: Expectation, robot_pose: Pose | None = None, stamp: float | None = None
+    ) -> AnchoringResult:
         """Record where an action expects an anchored object to be (provenance EXPECTED).
 
         The anchor moves there at once (a carried one when a robot pose is known) so gating and
         Find look in the right place; perception then confirms or retracts it.
+
+        A search for a MISSING anchor first looks at what was anchored while it was missing: an
+        object moved while the robot was elsewhere and seen again from afar got a new anchor,
+        because nothing said it was the lost one. If exactly one anchor of its class, first seen
+        after it went missing, lies in the searched disc, the search has found it: that anchor is
+        merged into the sought one, which keeps its symbol (see :meth:`_merge_into`). The result
+        holds the events of such a merge (none otherwise).
         """
         anchor = self._require(symbol)
+        when = self._latest_stamp if stamp is None else stamp
+        changes = _Changes(when if math.isfinite(when) else expectation.stamp)
+        if expectation.is_search and anchor.state is AnchorState.MISSING:
+            found = self._found_by_search(anchor, expectation)
+            if found is not None:
+                self._merge_into(anchor, found, changes)
+                return changes.result()
         anchor.expectation = expectation
         anchor.expectation_confirmed = False
         anchor.missed_frames = 0
@@ -269,6 +289,7 @@ class Anchoring:
         position = expectation.expected_position(robot_pose)
         if position is not None:
             self._move_to_expected(anchor, position)
+        return changes.result()
 
     def clear_expectation(self, symbol: str) -> None:
         """Drop an expectation that no longer applies (the carrying action ended, a search failed).
@@ -356,13 +377,22 @@ class Anchoring:
         return anchor
 
     def _reacquire(self, anchor: Anchor, percept: Percept, changes: _Changes, continued: bool) -> None:
-        if anchor.expectation is not None:
+        # A search for a missing anchor ends only once the anchor is back (see after_sighting):
+        # one false detection in the searched disc must not end the search.
+        searching = anchor.expectation is not None and anchor.expectation.is_search
+        if anchor.expectation is not None and not searching:
             self._resolve_expectation(anchor, percept, changes)
         was_missing = anchor.state is AnchorState.MISSING
+        missing_since = anchor.missing_since
         old_class = anchor.class_name
         anchor.absorb(percept, percept.embedding, self.config.fusion)
         became_confirmed = after_sighting(anchor, self.config.lifecycle)
-        self._missing.discard(anchor.symbol)
+        if anchor.state is AnchorState.MISSING:
+            anchor.missing_since = missing_since  # not back yet: still on the clock that forgets it
+        else:
+            self._missing.discard(anchor.symbol)
+            if searching:
+                self._resolve_expectation(anchor, percept, changes)
         self._index.refresh(anchor)
         if anchor.class_name != old_class:
             self._by_class[old_class].discard(anchor.symbol)
@@ -402,6 +432,53 @@ class Anchoring:
             return percepts
         needed = [row for row in rows if percepts[row].embedding is None and percepts[row].crop.size > 0]
         return with_embeddings(percepts, needed, self.embedder) if needed else percepts
+
+    # --- internals: top-down search ----------------------------------------------------------
+
+    def _found_by_search(self, sought: Anchor, search: Expectation) -> Anchor | None:
+        """The one anchor a search for ``sought`` explains: confirmed, same class, born after it
+        went missing, inside the searched disc, and (when both have galleries) looking alike."""
+        since = sought.missing_since if sought.missing_since is not None else sought.last_seen
+        reach = search.radius + self.config.expectation_tolerance
+        candidates = [
+            anchor
+            for anchor in self._index
+            if anchor is not sought
+            and anchor.class_name == sought.class_name
+            and anchor.first_seen >= since
+            and anchor.state is AnchorState.CONFIRMED  # a tentative one is too often a false detection
+            and anchor.expectation is None
+            and float(np.linalg.norm(anchor.position[:2] - search.position[:2])) <= reach
+            and self._look_alike(sought, anchor)
+        ]
+        return candidates[0] if len(candidates) == 1 else None
+
+    def _look_alike(self, first: Anchor, second: Anchor) -> bool:
+        """Appearance does not rule the pair out (unknown appearance rules nothing out)."""
+        if first.gallery is None or second.gallery is None or not len(first.gallery) or not len(second.gallery):
+            return True
+        return gallery_similarity(first.gallery, second.gallery) >= self.config.merge_similarity
+
+    def _merge_into(self, kept: Anchor, merged: Anchor, changes: _Changes) -> None:
+        """``merged`` was ``kept`` all along: ``kept`` takes its observations, ``merged`` goes."""
+        self._remove(merged)
+        merged.state = AnchorState.FORGOTTEN
+        kept.absorb_anchor(merged, self.config.fusion)
+        kept.expectation = None
+        kept.expectation_confirmed = False
+        self._expected.discard(kept.symbol)
+        self._missing.discard(kept.symbol)
+        kept.state = AnchorState.CONFIRMED
+        kept.missing_since = None
+        kept.missed_frames = 0
+        kept.recovery_sightings = 0
+        self._index.refresh(kept)
+        if kept.visible:
+            self._visible.add(kept.symbol)
+        changes.forgotten.append(merged)
+        changes.reacquired.append(kept)
+        changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"found to be {kept.symbol} by a search")
+        changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason="found by search", merged=merged.symbol)
 
     # --- internals: lifecycle ---------------------------------------------------------------
 

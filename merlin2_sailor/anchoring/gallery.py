@@ -41,3 +41,12 @@ def add_to_gallery(gallery: np.ndarray | None, embedding: np.ndarray, size: int)
             "the backbone changed while anchors existed. Forget the anchors or keep one backbone."
         )
     return np.concatenate((gallery[max(0, len(gallery) - size + 1) :], row))
+
+
+def gallery_similarity(first: np.ndarray, second: np.ndarray) -> float:
+    """The best cosine similarity between any view of one gallery and any view of the other."""
+    a = from_bfloat16_bits(first).astype(np.float64)
+    b = from_bfloat16_bits(second).astype(np.float64)
+    a /= np.maximum(np.linalg.norm(a, axis=1, keepdims=True), 1e-12)
+    b /= np.maximum(np.linalg.norm(b, axis=1, keepdims=True), 1e-12)
+    return float(np.max(a @ b.T))

@@ -53,7 +53,19 @@ def was_confirmed(anchor: Anchor, config: LifecycleConfig) -> bool:
 
 
 def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
-    """Update the state after an acquire or reacquire; True when the anchor became CONFIRMED."""
+    """Update the state after an acquire or reacquire; True when the anchor became CONFIRMED.
+
+    A MISSING anchor comes back only after ``confirm_after`` sightings with no frame in between
+    that should have shown it and did not, as a new anchor must earn trust: one false
+    detection near its old place must not tell a planner that a lost object is found.
+    """
+    if anchor.state is AnchorState.MISSING:
+        anchor.recovery_sightings += 1
+        if anchor.recovery_sightings < config.confirm_after:
+            return False
+        anchor.recovery_sightings = 0
+        anchor.state = AnchorState.CONFIRMED
+        return True
     if was_confirmed(anchor, config):
         became_confirmed = anchor.state is AnchorState.TENTATIVE
         anchor.state = AnchorState.CONFIRMED
@@ -68,6 +80,7 @@ def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleCon
     A tentative anchor never becomes MISSING: it only starts the clock that forgets it.
     """
     if anchor.state is AnchorState.MISSING:
+        anchor.recovery_sightings = 0  # sightings must be near in time to bring it back
         return False
     anchor.missed_frames += 1
     if anchor.missed_frames < config.missed_frames_to_missing:

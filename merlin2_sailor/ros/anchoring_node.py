@@ -31,6 +31,7 @@ from merlin2_sailor.anchoring.anchor_view import views_of
 from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig, AnchoringResult
 from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, PersistenceWorker
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.state_file import AnchoringStateFile
@@ -90,6 +91,14 @@ class AnchoringNode(Node):
             self, "save_period", 2.0, "Seconds between saves of the anchors.", minimum=0.1, maximum=3600.0)
         track_period = declare_parameter(
             self, "track_period", 0.5, "Seconds between Track steps.", minimum=0.05, maximum=60.0)
+        forget_after = declare_parameter(
+            self, "forget_after", 600.0,
+            "Seconds a confirmed anchor may stay missing before it is forgotten (and leaves the KB).",
+            minimum=0.0, maximum=1e9)
+        forget_tentative_after = declare_parameter(
+            self, "forget_tentative_after", 2.0,
+            "Seconds a never-confirmed anchor (often a false detection) survives not being seen where it should be.",
+            minimum=0.0, maximum=3600.0)
         stamp_tolerance = declare_parameter(
             self, "stamp_tolerance", 0.05,
             "Largest gap (s) between percepts and the camera pose / depth they are judged with.",
@@ -102,7 +111,8 @@ class AnchoringNode(Node):
         if saved and saved.owned_objects:
             self._symbols.note_used(saved.owned_objects)  # symbols the knowledge base has seen
         self._anchoring = Anchoring(
-            AnchoringConfig(world_frame=world_frame),
+            AnchoringConfig(world_frame=world_frame, lifecycle=LifecycleConfig(
+                forget_after=forget_after, forget_tentative_after=forget_tentative_after)),
             matcher=self._make_matcher(matcher, weights, backbone),
             # The network compares crops, so it needs them embedded; the rules never look at them.
             embedder=self._make_embedder(backbone) if matcher == "network" else None,
@@ -339,12 +349,13 @@ class AnchoringNode(Node):
     def _expect_anchor(self, request: srv.ExpectAnchor.Request, response: srv.ExpectAnchor.Response) -> Any:
         now = self.get_clock().now().nanoseconds * 1e-9
         position = np.array([request.position.x, request.position.y, request.position.z])
+        result = None
         try:
             with self._lock:
                 if request.symbol not in self._anchoring:
                     raise ConfigurationError(f"no anchor '{request.symbol}'")
                 if request.expectation == request.EXPECT_AT:
-                    self._anchoring.expect(request.symbol, Expectation.at(
+                    result = self._anchoring.expect(request.symbol, Expectation.at(
                         position, now, place=request.place, source=request.source, radius=float(request.radius)))
                 elif request.expectation == request.EXPECT_CARRIED:
                     self._anchoring.expect(request.symbol, Expectation.carried(
@@ -357,7 +368,10 @@ class AnchoringNode(Node):
             response.message = str(error)
             return response
         response.success = True
-        self._publish_state()
+        if result is not None and result.events:
+            self._publish(result)  # a search that found its object under a newer anchor: the merge
+        else:
+            self._publish_state()
         return response
 
 

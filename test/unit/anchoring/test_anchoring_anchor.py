@@ -128,8 +128,23 @@ def test_reacquired_missing_anchor_returns_to_its_trust_level(maker):
     after_sighting(anchor, config)
     after_expected_but_unseen(anchor, 1.0, config)
     anchor.absorb(maker.percept(CUP, 2.0), None, FusionConfig())
-    assert not after_sighting(anchor, config)  # back to confirmed, but not a new confirmation
+    assert after_sighting(anchor, config)  # confirmed again: it is back
     assert anchor.state is AnchorState.CONFIRMED and anchor.missing_since is None and anchor.missed_frames == 0
+
+
+def test_a_missing_anchor_needs_as_many_sightings_as_a_new_one_to_come_back(maker):
+    """One false detection near a lost object's old place must not say it is found."""
+    config = LifecycleConfig(confirm_after=3, missed_frames_to_missing=1)
+    anchor = new_anchor(maker)
+    anchor.times_seen = 3
+    after_sighting(anchor, config)
+    after_expected_but_unseen(anchor, 1.0, config)
+    assert anchor.state is AnchorState.MISSING
+    assert not after_sighting(anchor, config) and not after_sighting(anchor, config)
+    after_expected_but_unseen(anchor, 1.5, config)  # a frame that should have shown it did not
+    assert not after_sighting(anchor, config) and not after_sighting(anchor, config)
+    assert anchor.state is AnchorState.MISSING
+    assert after_sighting(anchor, config) and anchor.state is AnchorState.CONFIRMED
 
 
 @pytest.mark.parametrize(

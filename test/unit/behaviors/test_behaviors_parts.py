@@ -124,7 +124,13 @@ def mission_robot() -> FakeRobot:
 
 
 def run_mission(robot: FakeRobot, planner: Planner, *goals: Proposition):  # noqa: ANN201
-    behaviours = {name: action.make_state_machine(robot.context) for name, action in SAILOR_ACTIONS.items()}
+    """A fetch mission, with the actions such a mission allows (Aries is a satisficing planner:
+    given bring too, it may carry a cup around to get somewhere)."""
+    behaviours = {
+        name: action.make_state_machine(robot.context)
+        for name, action in SAILOR_ACTIONS.items()
+        if name in ("navigation", "approach_object", "find_object")
+    }
     return MissionRunner(robot.store, Dispatcher(robot.store, planner, behaviours)).run(Mission(goals))
 
 
