@@ -24,6 +24,7 @@ NODE_ENTRY_POINTS = [
     "world = merlin2_sailor_demos.world_node:main",
     "behaviors = merlin2_sailor_behaviors.ros.behaviors_node:main",
     "mission = merlin2_sailor_behaviors.mission.mission_node:main",
+    "mission_demo = merlin2_sailor_demos.mission_demo_node:main",
 ]
 
 # Command-line tools.

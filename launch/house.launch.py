@@ -34,5 +34,5 @@ def generate_launch_description() -> LaunchDescription:
                          ("depth/image_raw", "/camera/depth/image_raw")],
              output="screen"),
         Node(package="merlin2_sailor", executable="behaviors",
-             parameters=parameters("behaviors", grounding=grounding, look_dwell=0.5), output="screen"),
+             parameters=parameters("behaviors", grounding=grounding, look_dwell=0.3), output="screen"),
     ])

@@ -106,10 +106,13 @@ class MissionSession:
                 )
             time.sleep(0.5)
 
-    def run(self, goals: Sequence[Proposition], name: str = "mission") -> MissionResult:
-        """Run one mission to its end and word its outcome."""
+    def run(
+        self, goals: Sequence[Proposition], name: str = "mission", actions: Sequence[str] = ()
+    ) -> MissionResult:
+        """Run one mission to its end and word its outcome; ``actions`` narrows the ready ones."""
+        behaviours = {n: b for n, b in self._behaviours.items() if not actions or n in actions}
         dispatcher = Dispatcher(
-            self._store, self._planner, self._behaviours, DispatcherConfig(max_replans=self._config.max_replans)
+            self._store, self._planner, behaviours, DispatcherConfig(max_replans=self._config.max_replans)
         )
         runner = MissionRunner(self._store, dispatcher)
         with self._lock:

@@ -13,9 +13,11 @@ from merlin2_sailor_demos.report.scorecard import (
     score,
 )
 from merlin2_sailor_demos.report.top_down_map import MapLayers, draw_map
+from merlin2_sailor_demos.report.writer import DemoOutcome, truth_from_ground_truth, write_report
 
 __all__ = [
     "AnchorRecord",
+    "DemoOutcome",
     "IdentityHistory",
     "MapLayers",
     "Scorecard",
@@ -23,4 +25,6 @@ __all__ = [
     "associate",
     "draw_map",
     "score",
+    "truth_from_ground_truth",
+    "write_report",
 ]

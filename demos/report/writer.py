@@ -1,0 +1,96 @@
+"""Writing the mission demo's report folder from plain data: scorecard, map, PDDL, account, summary."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from merlin2_sailor_demos.report.scorecard import (
+    AnchorRecord,
+    IdentityHistory,
+    Scorecard,
+    TrueObject,
+    associate,
+    score,
+)
+from merlin2_sailor_demos.report.top_down_map import MapLayers, draw_map
+
+
+@dataclass(frozen=True)
+class DemoOutcome:
+    """What the demo set out to show, and whether it did."""
+
+    missions: Sequence[tuple[str, bool, str]]
+    """(name, succeeded, reason) of each mission, in order."""
+    target: str
+    target_symbol: str
+    target_found: bool
+    target_error: float
+    seconds: float
+
+    @property
+    def succeeded(self) -> bool:
+        return all(ok for _, ok, _ in self.missions) and self.target_found
+
+
+def truth_from_ground_truth(data: dict[str, Any]) -> list[TrueObject]:
+    """True objects from the world node's ground_truth.json (carried objects left out)."""
+    return [
+        TrueObject(obj["id"], obj["class"], tuple(obj["position"]))
+        for obj in data.get("objects", [])
+        if not obj.get("carried")
+    ]
+
+
+def write_report(
+    folder: Path,
+    truth: Sequence[TrueObject],
+    anchors: Sequence[AnchorRecord],
+    facts: Sequence[tuple[str, str]],
+    place_of: Callable[[TrueObject], str | None],
+    layers: MapLayers,
+    history: IdentityHistory,
+    pddl: str,
+    account: Sequence[str],
+    outcome: DemoOutcome,
+) -> Scorecard:
+    """Write every file of the report and return the scorecard."""
+    folder.mkdir(parents=True, exist_ok=True)
+    card = score(truth, anchors, facts, place_of, history)
+    association = associate(truth, [a for a in anchors if a.state in ("confirmed", "missing")])
+    draw_map(folder / "map.png", layers, truth, anchors, association,
+             title=f"SAILOR mission demo: {len(anchors)} anchors, {len(truth)} objects")
+    (folder / "knowledge.pddl").write_text(pddl)
+    (folder / "account.log").write_text("\n".join(account) + "\n")
+    (folder / "scorecard.json").write_text(json.dumps(
+        {**card.to_dict(), "identity_history": history.symbols, "outcome": {
+            "succeeded": outcome.succeeded, "missions": [list(m) for m in outcome.missions],
+            "target": outcome.target, "target_symbol": outcome.target_symbol,
+            "target_found": outcome.target_found, "target_error_m": outcome.target_error,
+            "seconds": outcome.seconds}}, indent=2))
+    lines = [
+        "# SAILOR mission demo",
+        "",
+        f"Result: **{'succeeded' if outcome.succeeded else 'failed'}** in {outcome.seconds:.0f} s.",
+        "",
+        "| mission | outcome | why |",
+        "| --- | --- | --- |",
+        *(f"| {name} | {'succeeded' if ok else 'failed'} | {reason} |" for name, ok, reason in outcome.missions),
+        "",
+        f"The {outcome.target.replace('_', ' ')} was anchored as `{outcome.target_symbol}`; after the world moved it, "
+        + (f"it was found again under the same symbol, {outcome.target_error:.2f} m from where it really is."
+           if outcome.target_found else "it was not found again under that symbol."),
+        "",
+        "## Scorecard against the world's ground truth",
+        "",
+        card.to_markdown(),
+        "Files: `map.png` (top-down: true objects in green, anchors as crosses), `frames/` (camera frames with "
+        "the anchors' boxes and symbols), `knowledge.pddl` (the final knowledge base), `account.log`, "
+        "`scorecard.json`.",
+        "",
+    ]
+    (folder / "summary.md").write_text("\n".join(lines))
+    return card
