@@ -35,6 +35,7 @@ from merlin2_sailor.ros.conversions import (
     image_to_rgb,
     stamp_to_seconds,
 )
+from merlin2_sailor.ros.newest_frame_mailbox import NewestFrameMailbox
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import SENSOR_DATA
@@ -50,41 +51,6 @@ WARNING_PERIOD_SECONDS = 5.0  # bad input is logged at most this often, whatever
 #: Masks are rasterised at the size they claim: one claiming more pixels than any camera image is
 #: refused unread (2**31 x 2**31 raised MemoryError and killed the node; less would fill the memory).
 MAXIMUM_MASK_PIXELS = 8192 * 8192
-
-
-class NewestFrameMailbox:
-    """A one-slot mailbox between a subscription and a worker: a newer frame replaces a waiting one.
-
-    ``dropped`` counts the frames replaced before the worker took them, i.e. the frames that
-    arrived while the worker was busy with an older one.
-    """
-
-    def __init__(self) -> None:
-        self._condition = threading.Condition()
-        self._waiting: Any = None
-        self._closed = False
-        self.dropped = 0
-
-    def put(self, frame: Any) -> None:
-        with self._condition:
-            if self._waiting is not None:
-                self.dropped += 1
-            self._waiting = frame
-            self._condition.notify()
-
-    def take(self) -> Any:
-        """Block until a frame is waiting and return it; None once the mailbox is closed."""
-        with self._condition:
-            self._condition.wait_for(lambda: self._waiting is not None or self._closed)
-            if self._closed:
-                return None
-            frame, self._waiting = self._waiting, None
-            return frame
-
-    def close(self) -> None:
-        with self._condition:
-            self._closed = True
-            self._condition.notify_all()
 
 
 class DetectorNode(Node):

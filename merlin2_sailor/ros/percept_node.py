@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -65,6 +66,7 @@ from merlin2_sailor.ros.conversions import (
     stamp_to_seconds,
     transform_to_pose,
 )
+from merlin2_sailor.ros.newest_frame_mailbox import NewestFrameMailbox
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import SENSOR_DATA
@@ -133,6 +135,12 @@ class PerceptNode(Node):
         self._published = TopicStatistics(window_seconds=report_period)
         self._dropped_reasons: Counter[str] = Counter()
         self._skipped_frames = 0
+        # Matched frames go to a worker through a one-slot mailbox: when percept generation falls
+        # behind the camera, the newest frame wins and the ones it replaced are counted.
+        self._statistics_lock = threading.Lock()
+        self._mailbox = NewestFrameMailbox()
+        self._worker = threading.Thread(target=self._work, name="percept-generator", daemon=True)
+        self._worker.start()
         self._report_period = report_period
         self._last_warning: dict[str, float] = {}
 
@@ -282,7 +290,14 @@ class PerceptNode(Node):
             self._warn(input_name, f"{input_name} dropped: {error}")
             return
         if matched is not None:
-            self._process(matched)
+            self._mailbox.put(matched)
+
+    def _work(self) -> None:
+        while (matched := self._mailbox.take()) is not None:
+            try:
+                self._process(matched)
+            except Exception as error:  # noqa: BLE001 - one bad frame must not stop percept generation
+                self._warn("worker", f"frame dropped: percept generation failed: {error!r}")
 
     def _refuse_future_stamp(self, header: Header) -> None:
         lead = stamp_to_seconds(header.stamp) - self._now()
@@ -338,7 +353,8 @@ class PerceptNode(Node):
             self._skip(frame_problems[0].detail)
             return
         for drop in batch.dropped:
-            self._dropped_reasons[drop.reason.value] += 1
+            with self._statistics_lock:
+                self._dropped_reasons[drop.reason.value] += 1
             self._warn(
                 f"percept:{drop.reason.value}",
                 f"detection '{drop.detection.class_name}' dropped ({drop.reason.value}): {drop.detail}",
@@ -349,10 +365,12 @@ class PerceptNode(Node):
         header = Header(stamp=image_stamp, frame_id=self._world_frame)
         self._percept_publisher.publish(percepts_to_message(percepts, header))
         self._marker_publisher.publish(percept_markers(percepts, header))
-        self._published.record(self._now(), stamp_to_seconds(image_stamp))
+        with self._statistics_lock:
+            self._published.record(self._now(), stamp_to_seconds(image_stamp))
 
     def _skip(self, reason: str) -> None:
-        self._skipped_frames += 1
+        with self._statistics_lock:
+            self._skipped_frames += 1
         self._warn("frame", f"frame skipped: {reason}")
 
     def _warn(self, key: str, text: str) -> None:
@@ -384,18 +402,29 @@ class PerceptNode(Node):
     # --- reporting --------------------------------------------------------------------------------
 
     def _report(self) -> None:
-        report = self._published.report(self._now())
-        if report.total_messages == 0 and self._skipped_frames == 0:
+        with self._statistics_lock:
+            report = self._published.report(self._now())
+            dropped_reasons = dict(self._dropped_reasons)
+            skipped = self._skipped_frames
+        busy_drops = self._mailbox.dropped
+        if report.total_messages == 0 and skipped == 0 and busy_drops == 0:
             return
         parts = [f"{report.messages} percept arrays in the last {self._report_period:g} s ({report.rate_hz:.1f} Hz)"]
         if report.mean_age_seconds is not None:
             parts.append(f"image-to-percepts latency {1000.0 * report.mean_age_seconds:.0f} ms")
-        if self._dropped_reasons:
+        if dropped_reasons:
             parts.append("detections dropped since start: " + ", ".join(
-                f"{reason} {count}" for reason, count in sorted(self._dropped_reasons.items())))
-        if self._skipped_frames:
-            parts.append(f"{self._skipped_frames} frames skipped since start")
+                f"{reason} {count}" for reason, count in sorted(dropped_reasons.items())))
+        if skipped:
+            parts.append(f"{skipped} frames skipped since start")
+        if busy_drops:
+            parts.append(f"{busy_drops} frames dropped since start while busy (the newest frame wins)")
         self.get_logger().info(", ".join(parts))
+
+    def destroy_node(self) -> None:
+        self._mailbox.close()
+        self._worker.join(timeout=5.0)
+        super().destroy_node()
 
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9

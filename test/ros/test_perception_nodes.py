@@ -40,7 +40,7 @@ from merlin2_sailor.ros.conversions import (
     seconds_to_stamp,
     stamp_to_seconds,
 )
-from merlin2_sailor.ros.detector_node import NewestFrameMailbox
+from merlin2_sailor.ros.newest_frame_mailbox import NewestFrameMailbox
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_demos.rgbd_sources import load_source
 from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray

@@ -135,9 +135,6 @@ def test_what_is_queued_when_the_camera_stops_is_bounded(load_run) -> None:
 
 
 @pytest.mark.ros
-@pytest.mark.xfail(strict=False, reason=(
-    "issue 9: percept_generator does not count the frames it drops; frames beyond its DDS queues (depth 5) "
-    "are lost silently. Needs a newest-frame mailbox with a drop counter, as the detector has"))
 def test_the_percept_generator_reports_the_frames_it_dropped(load_run) -> None:
     recording, phases = load_run
     dropped = sum(phase.dropped_percept_generator for phase in phases.values())
