@@ -53,6 +53,7 @@ from merlin2_sailor.ros.conversions import (
     stamp_to_seconds,
 )
 from merlin2_sailor.ros.conversions.anchoring import anchor_markers, anchors_to_message, events_to_message
+from merlin2_sailor.ros.newest_frame_mailbox import NewestFrameMailbox
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
@@ -63,6 +64,8 @@ NODE_NAME = "anchoring"
 #: Percepts stamped further than this ahead of the node's clock are refused: a camera clock gone
 #: wrong would otherwise expire every missing anchor at once ("missing since decades").
 FUTURE_STAMP_LIMIT_SECONDS = 10.0
+#: How often the percept arrays dropped while busy are reported (when there were any).
+DROP_REPORT_PERIOD_SECONDS = 5.0
 
 
 class AnchoringNode(Node):
@@ -140,6 +143,13 @@ class AnchoringNode(Node):
         self.create_service(srv.ForgetAnchor, "~/forget_anchor", self._forget_anchor)
         self.create_service(srv.ExpectAnchor, "~/expect_anchor", self._expect_anchor)
         self.create_timer(track_period, self._track)
+        # Percept arrays go to a worker through a one-slot mailbox: when anchoring falls behind
+        # the camera, the newest frame wins and the replaced ones are counted and reported.
+        self._mailbox = NewestFrameMailbox()
+        self._anchoring_thread = threading.Thread(target=self._anchor_frames, name="anchoring", daemon=True)
+        self._anchoring_thread.start()
+        self._reported_drops = 0
+        self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report_drops)
 
         self._worker = PersistenceWorker(
             self._copy_anchors, self._state_file, self._knowledge_base_opener(knowledge_base),
@@ -156,6 +166,8 @@ class AnchoringNode(Node):
             f"knowledge base: {knowledge_base or 'none'}")
 
     def destroy_node(self) -> None:
+        self._mailbox.close()
+        self._anchoring_thread.join(timeout=5.0)
         self._worker.stop()
         super().destroy_node()
 
@@ -232,6 +244,24 @@ class AnchoringNode(Node):
         self._depths.add(stamp_to_seconds(message.header.stamp), depth)
 
     def _on_percepts(self, message: PerceptArray) -> None:
+        self._mailbox.put(message)
+
+    def _anchor_frames(self) -> None:
+        while (message := self._mailbox.take()) is not None:
+            try:
+                self._anchor_frame(message)
+            except Exception as error:  # noqa: BLE001 - one frame must not stop anchoring
+                self.get_logger().error(f"frame dropped: anchoring failed: {error!r}")
+
+    def _report_drops(self) -> None:
+        dropped = self._mailbox.dropped
+        if dropped > self._reported_drops:
+            self.get_logger().warning(
+                f"{dropped - self._reported_drops} percept arrays dropped in the last "
+                f"{DROP_REPORT_PERIOD_SECONDS:g} s while busy (the newest frame wins; {dropped} since start)")
+            self._reported_drops = dropped
+
+    def _anchor_frame(self, message: PerceptArray) -> None:
         stamp = stamp_to_seconds(message.header.stamp)
         try:
             self._refuse_future_stamps(stamp, message)
