@@ -33,7 +33,7 @@ from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, PersistenceWorker
-from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.anchoring.state_file import AnchoringStateFile
 from merlin2_sailor.anchoring.symbols import SymbolCounter
 from merlin2_sailor.anchoring.visibility import CameraView
@@ -175,7 +175,17 @@ class AnchoringNode(Node):
 
     def _make_matcher(self, name: str, weights: str, backbone: str) -> Any:
         if name == "rules":
-            return RuleMatcher()
+            defaults = RuleMatcherConfig()
+            return RuleMatcher(RuleMatcherConfig(
+                position_sigma=declare_parameter(
+                    self, "rules_position_sigma", defaults.position_sigma,
+                    "rules: distance tolerance (m) of a percept and an anchor seen at the same time.",
+                    minimum=0.01, maximum=10.0),
+                maximum_sigma=declare_parameter(
+                    self, "rules_maximum_sigma", defaults.maximum_sigma,
+                    "rules: the tolerance's cap (m) however long the anchor has not been seen.",
+                    minimum=0.01, maximum=10.0),
+            ))
         if name == "network":
             from merlin2_sailor.anchoring.matching_network import NetworkMatcher
             from merlin2_sailor.models import default_weights_path
