@@ -37,14 +37,13 @@ from merlin2_sailor.errors import ConfigurationError, SailorError
 from merlin2_sailor.knowledge import ChangeEvent, Proposition
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
 from merlin2_sailor.resources import config_path
-from merlin2_sailor.ros.conversions.anchoring import EVENT_KIND_TO_MESSAGE
 from merlin2_sailor.ros.conversions.perception import camera_info_to_intrinsics, pose_from_message
 from merlin2_sailor.ros.conversions.sensors import image_to_array
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
 from merlin2_sailor_behaviors.mission.account import AnchorEventWording, describe_fact_changes
-from merlin2_sailor_behaviors.mission.mission_node import open_knowledge_base
+from merlin2_sailor_behaviors.mission.mission_node import anchor_event_lines, open_knowledge_base
 from merlin2_sailor_behaviors.mission.session import ForwardToRosLogger, MissionSession, SessionConfig
 from merlin2_sailor_demos.report import (
     AnchorRecord,
@@ -61,7 +60,6 @@ from merlin2_sailor_demos.world import load_world
 from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray
 
 _STATE_NAMES = {0: "tentative", 1: "confirmed", 2: "missing", 3: "forgotten"}
-_KIND_NAMES = {number: kind.value for kind, number in EVENT_KIND_TO_MESSAGE.items()}
 _PLANNING_LOGGER = "merlin2_sailor_behaviors.planning"
 EXPLORE_ACTIONS = ("navigation", "explore")
 FETCH_ACTIONS = ("navigation", "approach_object", "find_object")
@@ -123,8 +121,7 @@ class MissionDemoNode(Node):
         self.create_subscription(CameraInfo, "/camera/color/camera_info", self._on_camera_info, SENSOR_DATA)
         self.create_subscription(Image, "/camera/color/image_raw", self._on_image, SENSOR_DATA)
         self.create_timer(1.0, self._record_identities)
-        self._log_handler = ForwardToRosLogger(self)
-        self._log_handler.emit = self._forward_planning  # type: ignore[method-assign]
+        self._log_handler = ForwardToRosLogger(self, say=self._say)
         logging.getLogger(_PLANNING_LOGGER).addHandler(self._log_handler)
         logging.getLogger(_PLANNING_LOGGER).setLevel(logging.INFO)
         self._started = time.monotonic()
@@ -236,9 +233,6 @@ class MissionDemoNode(Node):
         self._account.append(line)
         self.get_logger().info(line)
 
-    def _forward_planning(self, record: logging.LogRecord) -> None:
-        self._say(record.getMessage())
-
     # Callbacks.
 
     def _on_fact_changes(self, events: Sequence[ChangeEvent]) -> None:
@@ -246,11 +240,8 @@ class MissionDemoNode(Node):
             self._say(f"fact {line}")
 
     def _on_anchor_events(self, message: AnchorEventArray) -> None:
-        for event in message.events:
-            reason = next((item.value for item in event.details if item.key == "reason"), "")
-            line = self._words.describe(_KIND_NAMES.get(event.kind, ""), event.symbol, event.class_name, reason)
-            if line:
-                self._say(line)
+        for line in anchor_event_lines(self._words, message):
+            self._say(line)
 
     def _on_anchors(self, message: AnchorArray) -> None:
         records = [

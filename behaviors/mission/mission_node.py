@@ -32,6 +32,17 @@ _KIND_NAMES = {number: kind.value for kind, number in EVENT_KIND_TO_MESSAGE.item
 _PLANNING_LOGGER = "merlin2_sailor_behaviors.planning"
 
 
+def anchor_event_lines(wording: AnchorEventWording, message: AnchorEventArray) -> list[str]:
+    """The running-account lines of one AnchorEventArray (routine events give none)."""
+    lines = []
+    for event in message.events:
+        reason = next((item.value for item in event.details if item.key == "reason"), "")
+        line = wording.describe(_KIND_NAMES.get(event.kind, str(event.kind)), event.symbol, event.class_name, reason)
+        if line:
+            lines.append(line)
+    return lines
+
+
 def open_knowledge_base(location: str, timeout: float = 5.0) -> KnowledgeBase:
     """``ros:///merlin2`` (the knowledge_base node) or any location open_store knows."""
     if location.startswith(ROS_PREFIX):
@@ -98,12 +109,8 @@ class MissionNode(Node):
             self.get_logger().info(f"fact {line}")
 
     def _on_anchor_events(self, message: AnchorEventArray) -> None:
-        for event in message.events:
-            reason = next((item.value for item in event.details if item.key == "reason"), "")
-            line = self._anchor_words.describe(
-                _KIND_NAMES.get(event.kind, str(event.kind)), event.symbol, event.class_name, reason)
-            if line:
-                self.get_logger().info(line)
+        for line in anchor_event_lines(self._anchor_words, message):
+            self.get_logger().info(line)
 
     def destroy_node(self) -> None:
         if self._worker is None:

@@ -149,17 +149,22 @@ class MissionSession:
 
 
 class ForwardToRosLogger(logging.Handler):
-    """Python logging (the dispatcher's plan and step lines) into a ROS node's logger.
+    """Python logging (the dispatcher's plan and step lines) into a ROS node's logger, or into
+    ``say`` when given (a running account that also keeps the lines).
 
     One rclpy call site per severity: rclpy refuses a call site whose severity changes.
     """
 
-    def __init__(self, node: Node) -> None:
+    def __init__(self, node: Node, say: Say | None = None) -> None:
         super().__init__(level=logging.INFO)
         self._logger = node.get_logger()
+        self._say = say
 
     def emit(self, record: logging.LogRecord) -> None:
         message = self.format(record)
+        if self._say is not None:
+            self._say(message)
+            return
         if record.levelno >= logging.ERROR:
             self._logger.error(message)
         elif record.levelno >= logging.WARNING:
