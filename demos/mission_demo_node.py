@@ -36,6 +36,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from merlin2_sailor.errors import ConfigurationError, SailorError
 from merlin2_sailor.knowledge import ChangeEvent, Proposition
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
+from merlin2_sailor.knowledge.pddl_writer import domain_from_store, problem_from_store
 from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions.perception import camera_info_to_intrinsics, pose_from_message
 from merlin2_sailor.ros.conversions.sensors import image_to_array
@@ -188,11 +189,9 @@ class MissionDemoNode(Node):
         outcome = DemoOutcome(missions, self._target, symbol, found and error <= 0.3, error,
                               time.monotonic() - self._started)
         facts = [p.objects for p in self._store.propositions.get_all() if p.predicate == "object_at" and not p.is_goal]
-        from merlin2_sailor.cli.knowledge_command import render_pddl
-
         card = write_report(
             self._folder, truth, anchors, [tuple(f) for f in facts], self._place_of, self._layers(), self._history,
-            render_pddl(self._store), self._account, outcome)
+            f"{domain_from_store(self._store)}\n\n{problem_from_store(self._store)}", self._account, outcome)
         self._say(f"report written to {self._folder}: summary.md, scorecard.json, map.png, "
                   f"{self._frames} frames, knowledge.pddl")
         for line in card.to_markdown().splitlines():
