@@ -316,6 +316,8 @@ def test_percept_generator_logs_bad_input_and_keeps_publishing(ros_probe, node_p
                              "-p", "tracker_frame_rate:=4.0")
     camera = SceneCamera(ros_probe, namespace)
     assert camera.wait_until_connected(), generator.text
+    # The first frame's percepts are asserted too: the generator's publisher must be known first.
+    assert ros_probe.wait_for(lambda: ros_probe.node.count_publishers(f"{namespace}/percepts") > 0), generator.text
 
     pose = camera_pose((0.0, 0.0, 1.0), 0.0)
     frame = render(pose)
