@@ -95,6 +95,9 @@ class WorldNode(Node):
                 self, "detection_minimum_visible_fraction", 0.3,
                 "Share of an object's silhouette that must be visible for a detection.", minimum=0.0, maximum=1.0),
         )
+        segment = declare_parameter(
+            self, "detection_masks", True,
+            "Give each ground-truth detection its instance mask, as a segmenting detector (YOLO-seg) does.")
         report_folder = declare_parameter(
             self, "report_folder", "", "Folder for ground_truth.json (rewritten on changes and at exit); empty: none.")
         self._world_frame = declare_parameter(self, "world_frame", "map", "Fixed frame of poses and markers.")
@@ -109,7 +112,7 @@ class WorldNode(Node):
                                              minimum=0.0, maximum=3600.0)
 
         path = config_path(world_file, DEFAULT_WORLD_FILE)
-        self._world = World(load_world(path), seed=seed, detector_noise=noise)
+        self._world = World(load_world(path), seed=seed, detector_noise=noise, segment=segment)
         self._max_speed = self._world.description.robot.limits.max_linear_speed
         self._lock = threading.Lock()
         self._report_path = Path(report_folder).expanduser() / GROUND_TRUTH_FILE if report_folder else None

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.knowledge import KnowledgeBase
 from merlin2_sailor_behaviors.actions.clients import AnchoringPort, GraspPort, NavigationPort
+from merlin2_sailor_behaviors.actions.look_history import LookHistory
 from merlin2_sailor_behaviors.actions.places import Places
 
 Log = Callable[[str, str], None]
@@ -44,6 +45,9 @@ class BehaviorConfig:
     """find_object: how far from a stop (other than where the object was last anchored) the
     object is searched for: a percept of its class anywhere that close may reacquire it. About
     a room's half-diagonal; 0 expects it exactly at the stop's point."""
+    look_fresh_for: float = 30.0
+    """explore: a complete look-around at the same waypoint this recently (by navigation, on
+    arrival) counts, and is not repeated; 0 always looks."""
     confirm_timeout: float = 5.0
     """bring: how long to look at the placed object for perception to confirm it."""
     poll_period: float = 0.2
@@ -62,7 +66,7 @@ class BehaviorConfig:
                 f"look_around_turns must be 0 (dwell only) or 2 or more, got {self.look_around_turns}"
             )
         for name in ("look_dwell", "approach_timeout", "reacquire_timeout", "search_radius", "confirm_timeout",
-                     "place_distance"):
+                     "place_distance", "look_fresh_for"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ConfigurationError(f"{name} must be a finite number >= 0, got {value!r}")
@@ -85,3 +89,5 @@ class BehaviorContext:
     places: Places
     config: BehaviorConfig = field(default_factory=BehaviorConfig)
     log: Log = python_log
+    looks: LookHistory = field(default_factory=LookHistory)
+    """The latest complete look-around, shared by the behaviours (explore skips a fresh one)."""

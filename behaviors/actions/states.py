@@ -182,7 +182,11 @@ class LookAround(BehaviorState):
             return SUCCEED
         turns = config.look_around_turns
         if turns == 0:
-            return SUCCEED if pause(config.look_dwell, self) else CANCEL
+            if not pause(config.look_dwell, self):
+                return CANCEL
+            self._record(target)
+            return SUCCEED
+        self.context.looks.forget()  # from the first turn on, the robot no longer looks as it did
         for turn in range(1, turns + 1):
             heading = target.pose.turned(turn * 2.0 * math.pi / turns)
             outcome, why = drive(self, Target(f"{target.name} (turn {turn}/{turns})", heading))
@@ -196,7 +200,12 @@ class LookAround(BehaviorState):
                 return CANCEL
             if self._stop_when is not None and self._stop_when(blackboard):
                 return SUCCEED
+        self._record(target)
         return SUCCEED
+
+    def _record(self, target: Target) -> None:
+        place = target.name.split(" (turn", 1)[0]
+        self.context.looks.record(place, target.pose.x, target.pose.y)
 
 
 def place_target(context: BehaviorContext, place_name: str) -> Target:

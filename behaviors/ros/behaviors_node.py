@@ -150,6 +150,10 @@ class BehaviorsNode(Node):
             "look_dwell": declare_parameter(
                 self, "look_dwell", defaults.look_dwell, "Seconds to stand still after each turn.",
                 minimum=0.0, maximum=60.0),
+            "look_fresh_for": declare_parameter(
+                self, "look_fresh_for", defaults.look_fresh_for,
+                "explore: seconds a look-around on arrival at the same waypoint counts (0: always look).",
+                minimum=0.0, maximum=3600.0),
             "approach_timeout": declare_parameter(
                 self, "approach_timeout", defaults.approach_timeout,
                 "approach_object: seconds to wait for the object to be seen again.", minimum=0.0, maximum=600.0),
@@ -266,12 +270,16 @@ class BehaviorsNode(Node):
                 self.get_logger().warning(f"{server.action.name} was still running at shutdown")
         self._registration.join(timeout=SHUTDOWN_WAIT_SECONDS)
         withdrawn = []
-        for action in self._registered:
+        for index, action in enumerate(self._registered):
             try:
                 if action.unregister(self._store):
                     withdrawn.append(action.name)
             except KnowledgeError as error:
-                self.get_logger().warning(f"could not withdraw {action.name} from the knowledge base: {error}")
+                # One failure says the knowledge base is gone (or going); asking again for each
+                # action would only spend the launcher's grace period on timeouts.
+                left = [later.name for later in self._registered[index:]]
+                self.get_logger().warning(f"could not withdraw {left} from the knowledge base: {error}")
+                break
         if withdrawn:
             self.get_logger().info(f"withdrew {withdrawn} from the knowledge base")
         self._store.close()

@@ -2,6 +2,9 @@
 
 The objects in view with at least ``minimum_visible_fraction`` of their silhouette visible (see
 :mod:`.visibility`) become detections of their true class, with the box of their visible part.
+With ``segment``, each also carries its instance mask (the visible silhouette, from the rendered
+instance image), as a segmenting detector such as YOLO-seg gives: the percept generator then
+measures depth on the object's own pixels, not on the table or door frame its box also covers.
 Then, from a seeded generator: each box edge moves by Gaussian noise of ``box_noise`` pixels,
 each detection is missed with ``miss_probability``, and a Poisson number of false positives
 (mean ``false_positives_per_frame``) of the world's classes appears at random places. Scores grow
@@ -49,14 +52,20 @@ class DetectorNoise:
 
 class GroundTruthDetector:
     def __init__(self, noise: DetectorNoise, width: int, height: int, false_positive_classes: Sequence[str],
-                 rng: np.random.Generator) -> None:
+                 rng: np.random.Generator, segment: bool = False) -> None:
         self.noise = noise
+        self.segment = segment
         self.width, self.height = width, height
         self._classes = tuple(sorted(set(false_positive_classes))) or ("cup",)
         self._rng = rng
 
-    def detect(self, objects: Sequence[WorldObject], visible: Sequence[Visibility]) -> list[Detection]:
-        """Detections for ``visible`` (indices into ``objects``), with noise; best score first."""
+    def detect(self, objects: Sequence[WorldObject], visible: Sequence[Visibility],
+               instance: np.ndarray | None = None) -> list[Detection]:
+        """Detections for ``visible`` (indices into ``objects``), with noise; best score first.
+
+        ``instance`` (the rendered frame's object index per pixel, -1 elsewhere) gives the masks
+        when the detector segments; false positives never have one.
+        """
         noise, rng = self.noise, self._rng
         detections = []
         for seen in visible:
@@ -70,7 +79,8 @@ class GroundTruthDetector:
                 continue
             score = float(np.clip(SCORE_BASE + SCORE_SLOPE * seen.fraction + rng.normal(0.0, SCORE_JITTER),
                                   *SCORE_RANGE))
-            detections.append(Detection(item.class_id, item.class_name, score, box))
+            mask = instance == seen.index if self.segment and instance is not None else None
+            detections.append(Detection(item.class_id, item.class_name, score, box, mask))
         for _ in range(int(rng.poisson(noise.false_positives_per_frame))):
             detections.append(self._false_positive())
         detections.sort(key=lambda detection: detection.score, reverse=True)

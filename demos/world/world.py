@@ -76,7 +76,7 @@ class SensorFrame:
 
 class World:
     def __init__(self, description: WorldDescription, seed: int = 0, detector_noise: DetectorNoise | None = None,
-                 darknet_data: str | None = None) -> None:
+                 darknet_data: str | None = None, segment: bool = False) -> None:
         self.description = description
         self.house = description.house
         self.camera = description.camera
@@ -94,7 +94,7 @@ class World:
         self.renderer = Renderer(self.house, self.camera, self.textures)
         classes = sorted({spec.class_name for spec in description.objects})
         self.detector = GroundTruthDetector(detector_noise or DetectorNoise(), self.camera.width, self.camera.height,
-                                            classes, np.random.default_rng(detector_seed))
+                                            classes, np.random.default_rng(detector_seed), segment)
         self.arrivals = 0
         self.visited: set[str] = set()
         self.version = 0
@@ -204,7 +204,8 @@ class World:
 
     def detect(self, frame: SensorFrame | None = None) -> list[Detection]:
         """Ground-truth detections with the configured noise, for ``frame`` or, without one, from geometry."""
-        return self.detector.detect(self.objects, self.visible_objects(frame))
+        instance = frame.instance if frame is not None else None
+        return self.detector.detect(self.objects, self.visible_objects(frame), instance)
 
     def in_view(self, box: Box) -> bool:
         """Whether any part of ``box`` is in the camera's view now (walls occlude, furniture does not)."""

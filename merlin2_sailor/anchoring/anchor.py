@@ -53,6 +53,8 @@ class Anchor:
     last_seen: float
     state: AnchorState = AnchorState.TENTATIVE
     times_seen: int = 1
+    whole_views: int = 0
+    """Sightings that showed the whole object (not cut by the image's edge or an occluder)."""
     last_tracker_id: str = ""
     """The tracker id of the latest percept that carried one; empty when none ever did."""
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -83,9 +85,10 @@ class Anchor:
 
     @classmethod
     def from_percept(
-        cls, symbol: str, percept: Percept, embedding: np.ndarray | None, config: FusionConfig
+        cls, symbol: str, percept: Percept, embedding: np.ndarray | None, config: FusionConfig, partial: bool = False
     ) -> Anchor:
-        """Acquire: a new, tentative anchor initialised from one percept."""
+        """Acquire: a new, tentative anchor initialised from one percept; from a ``partial`` view,
+        so uncertain that the first whole view takes its place."""
         position = np.array(percept.position, dtype=np.float64)
         return cls(
             symbol=symbol,
@@ -96,19 +99,32 @@ class Anchor:
             last_seen=percept.stamp,
             last_tracker_id=percept.tracker_id,
             class_votes=vote_class({}, percept.class_name, percept.score),
-            position_variance=config.initial_variance,
+            position_variance=config.initial_variance * (config.cut_off_variance_factor if partial else 1.0),
+            whole_views=0 if partial else 1,
             gallery=None if embedding is None else add_to_gallery(None, embedding, config.gallery_size),
             visible=True,
             perceived_position=position.copy(),
         )
 
-    def absorb(self, percept: Percept, embedding: np.ndarray | None, config: FusionConfig) -> None:
-        """Reacquire: fuse one more percept of this object into the anchor (never overwrite)."""
+    def absorb(
+        self, percept: Percept, embedding: np.ndarray | None, config: FusionConfig, partial: bool = False
+    ) -> None:
+        """Reacquire: fuse one more percept of this object into the anchor (never overwrite).
+
+        A ``partial`` view (cut by the image's edge or an occluder, see :mod:`.partial_view`) is
+        centred on the part in view: once the anchor has had a whole view, a partial one keeps it
+        alive but moves and resizes it no more; before that, it is the best there is, but weighs
+        ``cut_off_variance_factor`` times less.
+        """
         self.times_seen += 1
-        self.position, self.position_variance = fuse_position(
-            self.position, self.position_variance, percept.position, percept.stamp - self.last_seen, config
-        )
-        self.size = fuse_size(self.size, percept.size, self.times_seen, config)
+        if not partial or self.whole_views == 0:
+            self.position, self.position_variance = fuse_position(
+                self.position, self.position_variance, percept.position, percept.stamp - self.last_seen, config,
+                partial,
+            )
+        if not partial:
+            self.whole_views += 1
+            self.size = fuse_size(self.size, percept.size, self.whole_views, config)
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
         if embedding is not None:
@@ -132,6 +148,7 @@ class Anchor:
         self.position_variance = other.position_variance
         self.perceived_position = other.perceived_position.copy()
         self.size = other.size.copy()
+        self.whole_views = other.whole_views
         for class_name, votes in other.class_votes.items():
             self.class_votes[class_name] = self.class_votes.get(class_name, 0.0) + votes
         self.class_name = winning_class(self.class_votes, self.class_name)

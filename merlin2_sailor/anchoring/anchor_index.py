@@ -25,6 +25,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
 
@@ -68,6 +69,7 @@ class AnchorIndex:
         self._last_seen = np.zeros(0)
         self._class_names = np.zeros(0, dtype=object)
         self._search_radii = np.zeros(0)
+        self._extent_slacks = np.zeros(0)
         self._alive = np.zeros(0, dtype=bool)
         self._tree: cKDTree | None = None
         self._tree_slots = np.zeros(0, dtype=np.intp)
@@ -149,6 +151,13 @@ class AnchorIndex:
     def largest_search_radius(self) -> float:
         return float(np.max(self._search_radii[self._alive], initial=0.0)) if self._slot_of else 0.0
 
+    def extent_slacks_of(self, slots: np.ndarray) -> np.ndarray:
+        """How far from each anchor's centre a partial view of it may be centred (see features.extent_slack)."""
+        return self._extent_slacks[slots]
+
+    def largest_extent_slack(self) -> float:
+        return float(np.max(self._extent_slacks[self._alive], initial=0.0)) if self._slot_of else 0.0
+
     def within(self, points: np.ndarray, radius: float) -> list[np.ndarray]:
         """For each of the (N, 3) points, the slots of anchors within ``radius`` of it (sorted)."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
@@ -182,6 +191,7 @@ class AnchorIndex:
         self._last_seen[slot] = anchor.last_seen
         self._class_names[slot] = anchor.class_name
         self._search_radii[slot] = anchor.expectation.radius if anchor.expectation is not None else 0.0
+        self._extent_slacks[slot] = float(extent_slack(np.asarray(anchor.size, dtype=np.float64)))
 
     def _grow(self) -> int:
         """Open a new slot at the end, doubling the arrays' capacity when they are full."""
@@ -193,6 +203,7 @@ class AnchorIndex:
             self._last_seen = np.concatenate((self._last_seen, np.zeros(extra)))
             self._class_names = np.concatenate((self._class_names, np.zeros(extra, dtype=object)))
             self._search_radii = np.concatenate((self._search_radii, np.zeros(extra)))
+            self._extent_slacks = np.concatenate((self._extent_slacks, np.zeros(extra)))
             self._alive = np.concatenate((self._alive, np.zeros(extra, dtype=bool)))
             self._in_tree = np.concatenate((self._in_tree, np.zeros(extra, dtype=bool)))
             self._is_pending = np.concatenate((self._is_pending, np.zeros(extra, dtype=bool)))

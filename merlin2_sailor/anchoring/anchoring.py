@@ -31,6 +31,7 @@ from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation, ExpectationKind
 from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
 from merlin2_sailor.anchoring.gallery import gallery_similarity
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_expected_but_unseen, after_sighting, expire
 from merlin2_sailor.anchoring.matcher import Matcher
@@ -67,6 +68,7 @@ class AnchoringConfig:
     merge_similarity: float = 0.8
     table: MatchingTableConfig = field(default_factory=MatchingTableConfig)
     fusion: FusionConfig = field(default_factory=FusionConfig)
+    partial_view: PartialViewConfig = field(default_factory=PartialViewConfig)
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
     visibility: VisibilityConfig = field(default_factory=VisibilityConfig)
     index: IndexConfig = field(default_factory=IndexConfig)
@@ -217,16 +219,18 @@ class Anchoring:
         assignment = assign(table.scores, self.config.match_threshold)
         symbols = [""] * len(percepts)
         seen: set[str] = set()
+        partial = partial_views(percepts, camera, self.config.partial_view)
         for row, column in assignment.matches:
             anchor = table.anchors[column]
-            self._reacquire(anchor, percepts[row], changes, continued=bool(table.continuations[row, column]))
+            self._reacquire(anchor, percepts[row], changes, continued=bool(table.continuations[row, column]),
+                            partial=partial[row])
             symbols[row] = anchor.symbol
             seen.add(anchor.symbol)
 
         unmatched = [int(row) for row in assignment.unmatched_percepts]
         percepts = self._embed_for_gallery(percepts, unmatched)
         for row in unmatched:
-            anchor = self._acquire(percepts[row], changes)
+            anchor = self._acquire(percepts[row], changes, partial=partial[row])
             symbols[row] = anchor.symbol
             seen.add(anchor.symbol)
 
@@ -360,23 +364,26 @@ class Anchoring:
 
     # --- internals: acquire / reacquire -----------------------------------------------------
 
-    def _acquire(self, percept: Percept, changes: _Changes) -> Anchor:
+    def _acquire(self, percept: Percept, changes: _Changes, partial: bool = False) -> Anchor:
         symbol = self._new_symbol(percept.class_name)
         if symbol in self._index:
             raise SailorError(
                 f"The symbol factory returned {symbol!r}, which already names an anchor; it must never reuse a "
                 "symbol (use a persistent counter such as KnowledgeBase.new_symbol)."
             )
-        anchor = Anchor.from_percept(symbol, percept, percept.embedding, self.config.fusion)
+        anchor = Anchor.from_percept(symbol, percept, percept.embedding, self.config.fusion, partial)
         became_confirmed = after_sighting(anchor, self.config.lifecycle)
         self._insert(anchor)
         changes.acquired.append(anchor)
-        changes.event(AnchorEventKind.ACQUIRED, symbol, class_name=anchor.class_name, tracker_id=percept.tracker_id)
+        changes.event(AnchorEventKind.ACQUIRED, symbol, class_name=anchor.class_name, tracker_id=percept.tracker_id,
+                      at=_position_text(anchor.position))
         if became_confirmed:
             changes.event(AnchorEventKind.CONFIRMED, symbol, reason="seen", times_seen=anchor.times_seen)
         return anchor
 
-    def _reacquire(self, anchor: Anchor, percept: Percept, changes: _Changes, continued: bool) -> None:
+    def _reacquire(
+        self, anchor: Anchor, percept: Percept, changes: _Changes, continued: bool, partial: bool = False
+    ) -> None:
         # A search for a missing anchor ends only once the anchor is back (see after_sighting):
         # one false detection in the searched disc must not end the search.
         searching = anchor.expectation is not None and anchor.expectation.is_search
@@ -385,7 +392,8 @@ class Anchoring:
         was_missing = anchor.state is AnchorState.MISSING
         missing_since = anchor.missing_since
         old_class = anchor.class_name
-        anchor.absorb(percept, percept.embedding, self.config.fusion)
+        partial = partial or smaller_than_known(percept, anchor)
+        anchor.absorb(percept, percept.embedding, self.config.fusion, partial)
         became_confirmed = after_sighting(anchor, self.config.lifecycle)
         if anchor.state is AnchorState.MISSING:
             anchor.missing_since = missing_since  # not back yet: still on the clock that forgets it
@@ -597,3 +605,8 @@ def _frustum_reach(camera: CameraView, config: VisibilityConfig) -> float:
     half_width = max(intrinsics.cx, intrinsics.width - intrinsics.cx) / intrinsics.fx
     half_height = max(intrinsics.cy, intrinsics.height - intrinsics.cy) / intrinsics.fy
     return config.frustum.far * math.sqrt(1.0 + half_width**2 + half_height**2)
+
+
+def _position_text(position: np.ndarray) -> str:
+    """A position as people read it in a log line: where an object was first seen says much about why."""
+    return "(" + ", ".join(f"{float(value):.2f}" for value in position) + ")"

@@ -55,6 +55,23 @@ class FeatureConfig:
             raise ConfigurationError(f"feature time_scale must be a positive number of seconds, got {self.time_scale}.")
 
 
+#: Objects whose footprint (longest horizontal side, metres) is at most this are matched by their
+#: centres. A larger object's centre moves with the view (the near end of a bicycle seen end-on, a
+#: television half out of the picture), by up to half of what exceeds this, so that much distance
+#: between a percept and an anchor of it is forgiven in ``PairFeatures.footprint_distance`` (see
+#: :func:`extent_slack`), which the rule matcher scores. The network keeps the plain distance it
+#: was trained on.
+SMALL_OBJECT_EXTENT = 0.3
+
+
+def extent_slack(sizes: np.ndarray) -> np.ndarray:
+    """How far the centre of a partial view of an object of each (..., 3) size may lie from the
+    centre of the whole: half of its footprint beyond :data:`SMALL_OBJECT_EXTENT`, else 0."""
+    sizes = np.asarray(sizes, dtype=np.float64)
+    footprint = np.max(sizes[..., :2], axis=-1)
+    return np.maximum(footprint - SMALL_OBJECT_EXTENT, 0.0) / 2.0
+
+
 def encode_distance(distance: np.ndarray) -> np.ndarray:
     return np.exp(-np.asarray(distance, dtype=np.float64))
 
@@ -169,6 +186,7 @@ class PairFeatures:
     columns: np.ndarray
     same_class: np.ndarray  # (K,) bool
     distance: np.ndarray  # (K,) metres
+    footprint_distance: np.ndarray  # (K,) metres, less what a large object's extent explains
     distance_score: np.ndarray  # (K,) exp(-d)
     scale: np.ndarray  # (K,)
     time_difference: np.ndarray  # (K,) seconds, percept stamp minus anchor last seen
@@ -198,6 +216,9 @@ def pair_features(
     if anchors.perceived_positions is not None:
         perceived_distance = np.linalg.norm(percepts.positions[rows] - anchors.perceived_positions[columns], axis=1)
         distance = np.minimum(distance, perceived_distance)
+    # Two views of one large object need not share a centre: forgive what its extent explains.
+    slack = np.maximum(extent_slack(percepts.sizes[rows]), extent_slack(anchors.sizes[columns]))
+    footprint_distance = np.maximum(distance - slack, 0.0)
     time_difference = percepts.stamps[rows] - anchors.last_seen[columns]
     known = np.zeros(len(rows), dtype=bool)
     appearance_distance = np.full(len(rows), np.nan)
@@ -218,6 +239,7 @@ def pair_features(
         columns=columns,
         same_class=percepts.class_names[rows] == anchors.class_names[columns],
         distance=distance,
+        footprint_distance=footprint_distance,
         distance_score=encode_distance(distance),
         scale=scale_factor(percepts.sizes[rows], anchors.sizes[columns]),
         time_difference=time_difference,

@@ -33,13 +33,17 @@ class FusionConfig:
     ``drift_variance_rate`` (m^2/s): how fast uncertainty about an unseen anchor's position grows.
     ``initial_variance`` (m^2): the variance of a newly acquired anchor's position.
     ``size_smoothing``: the weight of a new size measurement once the anchor is well known.
-    ``gallery_size``: how many recent embeddings an anchor keeps."""
+    ``gallery_size``: how many recent embeddings an anchor keeps.
+    ``cut_off_variance_factor``: how many times less a partial view (cut by the image's edge or
+    an occluder, see :mod:`.partial_view`) moves an anchor than a whole one; its centre and size
+    are those of the part in view."""
 
     measurement_variance: float = 0.01
     drift_variance_rate: float = 0.01
     initial_variance: float = 0.01
     size_smoothing: float = 0.2
     gallery_size: int = 4
+    cut_off_variance_factor: float = 100.0
 
     def __post_init__(self) -> None:
         for name in ("measurement_variance", "initial_variance"):
@@ -52,6 +56,10 @@ class FusionConfig:
             )
         if not (0.0 < self.size_smoothing <= 1.0):
             raise ConfigurationError(f"fusion size_smoothing must be in (0, 1], got {self.size_smoothing}.")
+        if not (math.isfinite(self.cut_off_variance_factor) and self.cut_off_variance_factor >= 1.0):
+            raise ConfigurationError(
+                f"fusion cut_off_variance_factor must be at least 1, got {self.cut_off_variance_factor}."
+            )
         if self.gallery_size < 1:
             raise ConfigurationError(f"fusion gallery_size must be at least 1, got {self.gallery_size}.")
 
@@ -62,10 +70,13 @@ def fuse_position(
     measurement: np.ndarray,
     elapsed: float,
     config: FusionConfig,
+    partial: bool = False,
 ) -> tuple[np.ndarray, float]:
-    """Return the fused (position, variance) after ``elapsed`` seconds unseen and one measurement."""
+    """Return the fused (position, variance) after ``elapsed`` seconds unseen and one measurement
+    (``partial``: of a partial view, trusted ``cut_off_variance_factor`` times less)."""
     predicted_variance = variance + config.drift_variance_rate * max(0.0, elapsed)
-    gain = predicted_variance / (predicted_variance + config.measurement_variance)
+    measurement_variance = config.measurement_variance * (config.cut_off_variance_factor if partial else 1.0)
+    gain = predicted_variance / (predicted_variance + measurement_variance)
     fused = position + gain * (np.asarray(measurement, dtype=np.float64) - position)
     return fused, (1.0 - gain) * predicted_variance
 
@@ -87,3 +98,4 @@ def winning_class(votes: Mapping[str, float], current: str) -> str:
     """The class with most votes; the current class wins ties, so a tie never flips the symbol's class."""
     best = max(votes.values())
     return current if votes.get(current, -1.0) >= best else max(votes, key=votes.__getitem__)
+

@@ -35,7 +35,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
-from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
+from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
@@ -196,14 +196,16 @@ class MatchingTableBuilder:
         if len(percepts.stamps) == 0 or len(index) == 0:
             return empty, empty
         radius = float(self.gate_radius(float(percepts.stamps.max()) - index.oldest_last_seen()))
-        radius += index.largest_search_radius()
+        percept_slacks = extent_slack(percepts.sizes)
+        radius += index.largest_search_radius() + index.largest_extent_slack() + float(np.max(percept_slacks))
         per_row = index.within(percepts.positions, radius)
         rows = np.repeat(np.arange(len(per_row), dtype=np.intp), [len(slots) for slots in per_row])
         if rows.size == 0:
             return empty, empty
         slots = np.concatenate(per_row).astype(np.intp)
         distance = np.linalg.norm(percepts.positions[rows] - index.positions_of(slots), axis=1)
-        reach = self.gate_radius(percepts.stamps[rows] - index.last_seen_of(slots)) + index.search_radii_of(slots)
+        reach = (self.gate_radius(percepts.stamps[rows] - index.last_seen_of(slots)) + index.search_radii_of(slots)
+                 + np.maximum(index.extent_slacks_of(slots), percept_slacks[rows]))
         passing = distance <= reach
         if self.config.gate_class_mismatch:
             passing &= percepts.class_names[rows] == index.class_names_of(slots)

@@ -16,6 +16,7 @@ from merlin2_sailor import __version__
 from merlin2_sailor.errors import SailorError
 
 SUBCOMMANDS = (
+    "merlin2_sailor.cli.demo_command",
     "merlin2_sailor.cli.launch_command",
     "merlin2_sailor.cli.knowledge_command",
     "merlin2_sailor.cli.anchors_command",

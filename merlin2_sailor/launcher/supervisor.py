@@ -1,10 +1,10 @@
 """Run the processes of a launch, prefix their output, and stop them all together.
 
 Each node runs in its own process session, so a Ctrl-C in the terminal reaches only the
-supervisor, which then stops the nodes in order: SIGINT (rclpy's clean shutdown), then SIGTERM
-after a grace period, then SIGKILL. The launch ends when the user interrupts it, when a node whose
-exit policy is ``shutdown`` ends, or when an optional duration has passed; the result records how
-each process ended so the summary can say exactly what went wrong.
+supervisor, which then stops the nodes: SIGINT (rclpy's clean shutdown), last-started first,
+then SIGTERM after a grace period, then SIGKILL. The launch ends when the user interrupts it, when
+a node whose exit policy is ``shutdown`` ends, or when an optional duration has passed; the result
+records how each process ended so the summary can say exactly what went wrong.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from merlin2_sailor.launcher.command import build_command
 from merlin2_sailor.launcher.spec import ExitPolicy, LaunchSpec, NodeSpec
 
 _POLL_SECONDS = 0.05
+_STOP_STEP_SECONDS = 3.0  # how long one node may take to leave before the next is asked
 _COLOURS = ("\033[36m", "\033[32m", "\033[33m", "\033[35m", "\033[34m", "\033[91m")
 _RESET = "\033[0m"
 
@@ -152,8 +153,8 @@ class Supervisor:
     def _stop_all(self) -> None:
         if not self._stop_reason:
             self._stop_reason = "the launch failed to start"
+        self._interrupt_in_reverse_order()
         for signal_number, patience in (
-            (signal.SIGINT, self._grace_period),
             (signal.SIGTERM, 3.0),
             (signal.SIGKILL, 3.0),
         ):
@@ -161,17 +162,40 @@ class Supervisor:
             if not alive:
                 break
             for entry in alive:
-                entry.signal_sent = signal_number
-                try:
-                    os.killpg(entry.process.pid, signal_number)
-                except ProcessLookupError:
-                    pass
+                self._signal(entry, signal_number)
             deadline = time.monotonic() + patience
             while time.monotonic() < deadline and any(e.process.poll() is None for e in alive):
                 time.sleep(_POLL_SECONDS)
         for entry in self._running:
             entry.process.wait()
             entry.reader.join(timeout=2.0)
+
+    def _interrupt_in_reverse_order(self) -> None:
+        """SIGINT the nodes last-started first, each given a moment to leave before the next.
+
+        A launch file lists what others need first (the knowledge base before the nodes that
+        write to it), so stopping in reverse lets each node's shutdown (a last sync, withdrawing
+        its actions) still reach what it depends on. A node that does not leave within
+        ``_STOP_STEP_SECONDS`` does not hold up the rest; the grace period runs from the last SIGINT.
+        """
+        for entry in reversed(self._running):
+            if entry.process.poll() is not None:
+                continue
+            self._signal(entry, signal.SIGINT)
+            step_end = time.monotonic() + min(_STOP_STEP_SECONDS, self._grace_period)
+            while time.monotonic() < step_end and entry.process.poll() is None:
+                time.sleep(_POLL_SECONDS)
+        deadline = time.monotonic() + self._grace_period
+        while time.monotonic() < deadline and any(entry.process.poll() is None for entry in self._running):
+            time.sleep(_POLL_SECONDS)
+
+    @staticmethod
+    def _signal(entry: _Running, signal_number: int) -> None:
+        entry.signal_sent = signal_number
+        try:
+            os.killpg(entry.process.pid, signal_number)
+        except ProcessLookupError:
+            pass
 
     def _outcome(self, entry: _Running) -> ProcessOutcome:
         return_code = entry.process.returncode

@@ -50,6 +50,13 @@ class Box3DConfig:
     outside it are treated as missing.
     ``maximum_median_samples``: the robust depth is the median of at most this many regularly
     spaced pixels, which bounds its cost on large boxes without changing it measurably.
+    ``minimum_depth_coverage``: the fraction of the central region (inside the mask, if any) that
+    must have usable depth. Below it the object itself is mostly unmeasured (beyond the sensor's
+    range, seen through a doorway) and the few readings there belong to something else, such as
+    the door frame: the detection is rejected rather than anchored on the wall.
+    ``mask_depth_gap``: with an instance mask, the object's points are the run of depths around
+    the median with no gap wider than this (metres) instead of the fixed band, so that a wide
+    object seen at a slant is kept whole.
     """
 
     depth_band_half_width: float = 0.2
@@ -59,12 +66,18 @@ class Box3DConfig:
     minimum_depth: float = 0.1
     maximum_depth: float = 20.0
     maximum_median_samples: int = 4096
+    minimum_depth_coverage: float = 0.25
+    mask_depth_gap: float = 0.1
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.depth_band_half_width) and self.depth_band_half_width > 0.0):
             raise ConfigurationError(
                 f"depth_band_half_width must be a positive number of metres, got {self.depth_band_half_width}."
             )
+        if not (math.isfinite(self.mask_depth_gap) and self.mask_depth_gap > 0.0):
+            raise ConfigurationError(f"mask_depth_gap must be a positive number of metres, got {self.mask_depth_gap}.")
+        if not (0.0 <= self.minimum_depth_coverage <= 1.0):
+            raise ConfigurationError(f"minimum_depth_coverage must be in [0, 1], got {self.minimum_depth_coverage}.")
         if not (0.0 < self.central_region_fraction <= 1.0):
             raise ConfigurationError(f"central_region_fraction must be in (0, 1], got {self.central_region_fraction}.")
         for name in ("minimum_valid_pixels", "minimum_central_pixels", "maximum_median_samples"):
@@ -85,6 +98,7 @@ class RejectionReason(StrEnum):
     INVALID_MASK = "invalid_mask"
     TOO_FEW_DEPTH_PIXELS = "too_few_depth_pixels"
     TOO_FEW_PIXELS_IN_BAND = "too_few_pixels_in_band"
+    DEPTH_MOSTLY_MISSING = "depth_mostly_missing"
     INVALID_FRAME = "invalid_frame"
 
 
@@ -252,10 +266,24 @@ def _estimate_one(
     center_depth = _robust_depth(window_range, window_mask, config)
     if center_depth is None:
         return _too_few_pixels(index, window_range, window_mask, config, band_count=0, center_depth=math.nan)
+    coverage = _central_coverage(window_range, window_mask, config)
+    if coverage < config.minimum_depth_coverage:
+        too_few = _too_few_pixels(index, window_range, window_mask, config, band_count=0, center_depth=center_depth)
+        if too_few.reason is RejectionReason.TOO_FEW_DEPTH_PIXELS:
+            return too_few  # the more specific reason
+        return Rejection(
+            index,
+            RejectionReason.DEPTH_MOSTLY_MISSING,
+            f"{100 * coverage:.0f}% of the box's centre has usable depth, under "
+            f"{100 * config.minimum_depth_coverage:.0f}%: the object is likely beyond the sensor's range",
+        )
     # The band and the sensor range are both intervals, so one pair of comparisons does both, and
     # comparisons with NaN are False, so it also discards missing readings.
-    band_low = max(center_depth - config.depth_band_half_width, config.minimum_depth)
-    band_high = min(center_depth + config.depth_band_half_width, config.maximum_depth)
+    if window_mask is not None:
+        band_low, band_high = _mask_surface_interval(window_range, window_mask, center_depth, config)
+    else:
+        band_low = max(center_depth - config.depth_band_half_width, config.minimum_depth)
+        band_high = min(center_depth + config.depth_band_half_width, config.maximum_depth)
     band = (window_range >= band_low) & (window_range <= band_high)
     if window_mask is not None:
         band &= window_mask
@@ -274,6 +302,36 @@ def _estimate_one(
         center_depth=center_depth,
         point_count=band_count,
     )
+
+
+def _mask_surface_interval(
+    window_range: np.ndarray, window_mask: np.ndarray, center_depth: float, config: Box3DConfig
+) -> tuple[float, float]:
+    """The depth interval of the object's surface under a mask: the run of depths around the
+    median with no gap wider than ``mask_depth_gap``.
+
+    A mask already leaves out the floor and the table, so the fixed band is not needed against
+    them, and it would cut a wide object seen at a slant (a television's far end is a metre
+    deeper than its near end). What a mask's edge still catches (a sliver of wall behind) lies
+    beyond a gap in depth, and stays out.
+    """
+    stride = max(1, math.ceil(math.sqrt(window_range.size / config.maximum_median_samples)))
+    region = (slice(None, None, stride),) * 2
+    depths = np.sort(_usable_values(window_range, window_mask, region, config))
+    if depths.size < 2:
+        return (max(center_depth - config.depth_band_half_width, config.minimum_depth),
+                min(center_depth + config.depth_band_half_width, config.maximum_depth))
+    # Sampling every stride-th pixel makes the steps between the depths of a slanted surface
+    # stride times larger: the gap that separates two surfaces grows with it.
+    gap = config.mask_depth_gap * stride
+    breaks = np.flatnonzero(np.diff(depths) > gap)  # a break lies after depths[i]
+    middle = int(np.searchsorted(depths, center_depth))
+    below = breaks[breaks < middle]
+    above = breaks[breaks >= middle]
+    low = depths[below[-1] + 1] if below.size else depths[0]
+    high = depths[above[0]] if above.size else depths[-1]
+    # The sample skips pixels: widen by one gap so the skipped ones of the same surface are kept.
+    return max(float(low) - gap, config.minimum_depth), min(float(high) + gap, config.maximum_depth)
 
 
 def _usable(values: np.ndarray, config: Box3DConfig) -> np.ndarray:
@@ -312,6 +370,34 @@ def _too_few_pixels(
     )
 
 
+def _central_region(window_shape: tuple[int, ...], config: Box3DConfig) -> tuple[slice, slice]:
+    """The central part of a window, sampled on a grid of at most ``maximum_median_samples`` pixels."""
+    window_height, window_width = window_shape
+    margin_rows = int(window_height * (1.0 - config.central_region_fraction) / 2.0)
+    margin_columns = int(window_width * (1.0 - config.central_region_fraction) / 2.0)
+    central_pixels = (window_height - 2 * margin_rows) * (window_width - 2 * margin_columns)
+    stride = max(1, math.ceil(math.sqrt(central_pixels / config.maximum_median_samples)))
+    return (
+        slice(margin_rows, window_height - margin_rows, stride),
+        slice(margin_columns, window_width - margin_columns, stride),
+    )
+
+
+def _central_coverage(window_range: np.ndarray, window_mask: np.ndarray | None, config: Box3DConfig) -> float:
+    """The fraction of the central region's pixels (inside the mask, if any) with usable depth."""
+    if config.minimum_depth_coverage <= 0.0:
+        return 1.0
+    central = _central_region(window_range.shape, config)
+    usable = _usable(window_range[central], config)
+    if window_mask is None:
+        return float(np.count_nonzero(usable)) / max(usable.size, 1)
+    inside = window_mask[central]
+    inside_count = int(np.count_nonzero(inside))
+    if inside_count == 0:
+        return 1.0  # the mask misses the centre: coverage says nothing there; the pixel counts decide
+    return float(np.count_nonzero(usable & inside)) / inside_count
+
+
 def _robust_depth(window_range: np.ndarray, window_mask: np.ndarray | None, config: Box3DConfig) -> float | None:
     """Median depth of the central region, or of the whole box when the centre has too few readings.
 
@@ -320,15 +406,7 @@ def _robust_depth(window_range: np.ndarray, window_mask: np.ndarray | None, conf
     selection it needs grows with the number of pixels. Returns None when the box has no usable
     depth at all.
     """
-    window_height, window_width = window_range.shape
-    margin_rows = int(window_height * (1.0 - config.central_region_fraction) / 2.0)
-    margin_columns = int(window_width * (1.0 - config.central_region_fraction) / 2.0)
-    central_pixels = (window_height - 2 * margin_rows) * (window_width - 2 * margin_columns)
-    stride = max(1, math.ceil(math.sqrt(central_pixels / config.maximum_median_samples)))
-    central = (
-        slice(margin_rows, window_height - margin_rows, stride),
-        slice(margin_columns, window_width - margin_columns, stride),
-    )
+    central = _central_region(window_range.shape, config)
     central_values = _usable_values(window_range, window_mask, central, config)
     if central_values.size >= config.minimum_central_pixels:
         return float(np.median(central_values, overwrite_input=True))

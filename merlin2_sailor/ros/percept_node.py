@@ -197,6 +197,10 @@ class PerceptNode(Node):
             minimum_valid_pixels=declare_parameter(
                 self, "minimum_valid_pixels", 20, "Fewer usable depth pixels and the detection is dropped.",
                 minimum=1, maximum=1_000_000),
+            minimum_depth_coverage=declare_parameter(
+                self, "minimum_depth_coverage", 0.25,
+                "Fraction of a box's centre that must have usable depth; below it the object is out of range.",
+                minimum=0.0, maximum=1.0),
             minimum_depth=declare_parameter(self, "minimum_depth", 0.1, "Nearest trusted depth (m).",
                                             minimum=0.0, maximum=100.0),
             maximum_depth=declare_parameter(self, "maximum_depth", 20.0, "Farthest trusted depth (m).",

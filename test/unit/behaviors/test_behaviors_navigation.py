@@ -121,6 +121,25 @@ def test_explore_turns_through_a_full_circle_at_the_waypoint(robot: FakeRobot) -
     assert [round(math.degrees(g.yaw)) % 360 for g in goals] == [180, 270, 0, 90]
 
 
+def test_explore_right_after_navigation_looked_around_there_does_not_turn_again(robot: FakeRobot) -> None:
+    put(robot, "cup_1", "b", (2.3, 0.2, 0.8))  # expected at b: navigation looks around on arrival
+    assert run(robot, NAVIGATION_ACTION, "a", "b")[0] == SUCCEED
+    goals_after_navigation = len(robot.navigation.goals)
+    assert run(robot, EXPLORE_ACTION, "b")[0] == SUCCEED
+    assert len(robot.navigation.goals) == goals_after_navigation  # no second 360 degrees
+    assert ("info", "explore(b): looked all around here on arrival; not again") in robot.logs
+    robot.navigation.pose = Pose2D(0.0, 0.0, 0.0)  # elsewhere now: a look at b says nothing about a
+    assert run(robot, EXPLORE_ACTION, "a")[0] == SUCCEED
+    assert len(robot.navigation.goals) == goals_after_navigation + FAST.look_around_turns
+
+
+def test_an_old_look_is_not_taken_for_a_fresh_one() -> None:
+    robot = make_robot(BehaviorConfig(look_around_turns=2, look_dwell=0.0, look_fresh_for=0.0))
+    assert run(robot, EXPLORE_ACTION, "a")[0] == SUCCEED
+    assert run(robot, EXPLORE_ACTION, "a")[0] == SUCCEED
+    assert len(robot.navigation.goals) == 4  # looked twice: with 0 s fresh, every look is a new one
+
+
 def test_explore_aborts_when_it_cannot_turn(robot: FakeRobot) -> None:
     robot.navigation.unreachable.add((0.0, 0.0))
     outcome, blackboard = run(robot, EXPLORE_ACTION, "a")

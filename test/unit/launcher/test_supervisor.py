@@ -93,3 +93,36 @@ def test_request_stop_from_another_thread_ends_the_launch(tmp_path: Path) -> Non
     result = supervisor.run()
     assert result.stop_reason == "interrupted by the user"
     assert result.succeeded
+
+
+# Writes the moment it got SIGINT to <name>.stopped, then lingers a little as a node's shutdown does.
+RECORDING_NODE = textwrap.dedent("""
+    import pathlib, signal, sys, time
+    def leave(*_):
+        pathlib.Path(sys.argv[0]).with_suffix(".stopped").write_text(repr(time.monotonic()))
+        time.sleep(0.2)
+        sys.exit(0)
+    signal.signal(signal.SIGINT, leave)
+    print("up", flush=True)
+    while True:
+        time.sleep(0.05)
+""")
+
+
+def test_nodes_are_interrupted_last_started_first(tmp_path: Path) -> None:
+    """The knowledge base (listed first) must outlive the nodes whose shutdown still writes to it."""
+    names = ["knowledge_base", "anchoring", "behaviors"]
+    supervisor = launch(tmp_path, {name: RECORDING_NODE for name in names})
+    result = supervisor.run(duration=1.5)
+    assert result.succeeded
+    stopped_at = {name: float((tmp_path / f"{name}.stopped").read_text()) for name in names}
+    assert sorted(names, key=stopped_at.get) == ["behaviors", "anchoring", "knowledge_base"]
+    assert stopped_at["knowledge_base"] - stopped_at["behaviors"] >= 0.3  # each had left before the next
+
+
+def test_a_node_ignoring_sigint_does_not_keep_the_others_from_their_sigint(tmp_path: Path) -> None:
+    supervisor = launch(tmp_path, {"first": RECORDING_NODE, "stubborn": STUBBORN_NODE})
+    result = supervisor.run(duration=1.0)
+    endings = {outcome.label: outcome.ending for outcome in result.outcomes}
+    assert endings == {"first": Ending.STOPPED, "stubborn": Ending.TERMINATED}
+    assert (tmp_path / "first.stopped").exists()

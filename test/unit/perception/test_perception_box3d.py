@@ -252,3 +252,44 @@ def test_motorcycle_from_middlebury_ground_truth(motorcycle_scene: RgbdScene) ->
     x_min, y_min, x_max, y_max = MOTORCYCLE_BOX.corners
     assert x_min + 0.3 * MOTORCYCLE_BOX.width < pixels[0, 0] < x_max - 0.3 * MOTORCYCLE_BOX.width
     assert y_min + 0.3 * MOTORCYCLE_BOX.height < pixels[0, 1] < y_max - 0.3 * MOTORCYCLE_BOX.height
+
+
+def test_an_object_beyond_the_range_seen_past_a_door_frame_is_rejected_not_placed_on_the_frame() -> None:
+    """Most of the box has no depth (the object is too far); its in-range pixels are the frame's."""
+    depth, intrinsics = wall_with_box_scene(object_corners=OBJECT, object_depth=OBJECT_DEPTH)
+    x_min, y_min, x_max, y_max = OBJECT
+    depth[y_min:y_max, x_min:x_max] = np.nan  # the object: beyond the sensor's range
+    frame_edge = x_min + (x_max - x_min) // 5
+    depth[y_min:y_max, x_min:frame_edge] = 1.2  # a door frame in front of its left fifth
+    [result] = estimate_boxes_from_depth([BoundingBox2D.from_corners(*OBJECT)], depth, intrinsics, Pose.identity())
+    assert isinstance(result, Rejection)
+    assert result.reason is RejectionReason.DEPTH_MOSTLY_MISSING
+    assert "beyond the sensor's range" in result.detail
+
+    # With the check off, the same box is "found" on the frame: what the check is there for.
+    [placed] = estimate_boxes_from_depth([BoundingBox2D.from_corners(*OBJECT)], depth, intrinsics, Pose.identity(),
+                                         Box3DConfig(minimum_depth_coverage=0.0))
+    assert isinstance(placed, Box3D) and placed.center_depth == pytest.approx(1.2)
+
+
+def test_depth_coverage_must_be_a_fraction() -> None:
+    with pytest.raises(ConfigurationError, match="minimum_depth_coverage"):
+        Box3DConfig(minimum_depth_coverage=1.5)
+
+
+def test_with_a_mask_a_slanted_object_is_kept_whole_and_the_wall_its_edge_catches_left_out() -> None:
+    """A television seen at a slant: 1 m deeper at one end. The band would cut it to 0.4 m."""
+    depth, intrinsics = wall_with_box_scene(wall_depth=6.0)
+    depth[150:330, 200:300] = 2.0 + 0.01 * np.arange(100, dtype=np.float32)
+    mask = np.zeros(depth.shape, dtype=bool)
+    mask[150:330, 198:300] = True  # the mask's edge bleeds two columns onto the wall behind
+    box2d = BoundingBox2D.from_corners(*OBJECT)
+    masked = only_box(estimate_boxes_from_depth([box2d], depth, intrinsics, Pose.identity(), masks=[mask]))
+    assert masked.size[2] == pytest.approx(0.99, abs=0.011)  # the whole slope, and no wall (at 6 m)
+    unmasked = only_box(estimate_boxes_from_depth([box2d], depth, intrinsics, Pose.identity()))
+    assert unmasked.size[2] == pytest.approx(0.4, abs=0.011)
+
+
+def test_mask_depth_gap_must_be_positive() -> None:
+    with pytest.raises(ConfigurationError, match="mask_depth_gap"):
+        Box3DConfig(mask_depth_gap=0.0)

@@ -85,3 +85,19 @@ def test_hidden_or_mostly_cut_off_objects_are_not_detected() -> None:
     fractions = {world.objects[s.index].id: s.fraction for s in world.visible_objects(frame)}
     assert "behind" not in fractions and 0.0 < fractions["cut_off"] < 0.3
     assert len(world.detect(frame)) == 1
+
+
+def test_a_segmenting_detector_gives_each_object_its_visible_silhouette() -> None:
+    world = World(room_world(objects=[mug("a", 3.5, 1.6), mug("b", 3.0, 2.5, size=(0.2, 0.2, 0.4))],
+                             size=(5.0, 4.0)), detector_noise=EXACT, segment=True)
+    frame = world.render()
+    detections = world.detect(frame)
+    assert len(detections) == 2
+    for detection in detections:
+        assert detection.mask is not None and detection.mask.shape == frame.instance.shape
+        ids = np.unique(frame.instance[detection.mask])
+        assert len(ids) == 1 and ids[0] >= 0  # one object's pixels, nothing else
+        rows, columns = np.nonzero(detection.mask)
+        x_min, y_min, x_max, y_max = detection.box.corners
+        assert x_min <= columns.min() and columns.max() < x_max and y_min <= rows.min() and rows.max() < y_max
+    assert all(d.mask is None for d in _world().detect(frame))  # a plain detector gives boxes only

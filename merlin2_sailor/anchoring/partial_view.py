@@ -1,0 +1,112 @@
+"""Is a percept a partial view of its object? Cut by the image's edge, or by something in front.
+
+A percept's position is the middle of the object's points the camera saw. When part of the
+object is outside the picture, or hidden behind a door frame or a table, that middle is the
+middle of the part in view, off by up to half the object's extent: a television seen past a
+door frame is anchored at its near end. Such a view still proves the object is there (it keeps
+the anchor alive), but it should barely move the anchor (see ``FusionConfig.cut_off_variance_factor``).
+
+Two tests, both cheap: the 2D box comes within ``edge_margin`` pixels of the image's edge; or,
+with a depth image, a strip of pixels just outside the left, right or top side of the box is
+clearly nearer than the object's front (its centre's depth less half its extent, less
+``occluder_margin`` metres), so the object goes on behind an occluder there. The bottom side is
+not asked: what is just below an object in the picture is mostly what it stands on, a little
+nearer than it by nature. A strip without depth proves nothing.
+
+Neither test sees an object hidden by a thin wall just in front of it (a television behind a
+door frame's wall): for a large object already seen whole, a view much smaller than what the
+anchor knows of it is taken as partial too (:func:`smaller_than_known`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
+from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.anchoring.visibility import CameraView
+from merlin2_sailor.errors import ConfigurationError
+
+
+@dataclass(frozen=True, slots=True)
+class PartialViewConfig:
+    """``edge_margin`` (pixels), ``occluder_margin`` (m) and ``strip_width`` (pixels): see the module."""
+
+    edge_margin: float = 4.0
+    occluder_margin: float = 0.15
+    strip_width: int = 3
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.edge_margin) and self.edge_margin >= 0.0):
+            raise ConfigurationError(f"partial view edge_margin must be >= 0 pixels, got {self.edge_margin}.")
+        if not (math.isfinite(self.occluder_margin) and self.occluder_margin > 0.0):
+            raise ConfigurationError(
+                f"partial view occluder_margin must be a positive number of metres, got {self.occluder_margin}."
+            )
+        if self.strip_width < 1:
+            raise ConfigurationError(f"partial view strip_width must be at least 1 pixel, got {self.strip_width}.")
+
+
+def partial_views(percepts: Sequence[Percept], camera: CameraView | None, config: PartialViewConfig) -> list[bool]:
+    """For each percept, whether it is a partial view (all False without a camera)."""
+    if camera is None or not percepts:
+        return [False] * len(percepts)
+    width, height = camera.intrinsics.width, camera.intrinsics.height
+    flags = [_touches_edge(percept.box.corners, width, height, config.edge_margin) for percept in percepts]
+    if camera.depth is None:
+        return flags
+    depth = np.asarray(camera.depth)
+    positions = np.array([percept.position for percept in percepts], dtype=np.float64).reshape(-1, 3)
+    object_depths = camera.camera_to_world.inverse().transform_points(positions)[:, 2]
+    for index, percept in enumerate(percepts):
+        if not flags[index]:
+            front = float(object_depths[index]) - 0.5 * float(np.max(percept.size[:2]))
+            flags[index] = _occluded_at_a_side(percept.box.corners, depth, front, config)
+    return flags
+
+
+#: A view of a large object whose footprint is under this share of the footprint the anchor
+#: knows from whole views is a partial view.
+PARTIAL_FOOTPRINT_SHARE = 0.6
+
+
+def smaller_than_known(percept: Percept, anchor: Anchor) -> bool:
+    """Whether a percept shows clearly less of a large object than the anchor's whole views did."""
+    if anchor.whole_views == 0:
+        return False
+    known = float(np.max(anchor.size[:2]))
+    return known > SMALL_OBJECT_EXTENT and float(np.max(percept.size[:2])) < PARTIAL_FOOTPRINT_SHARE * known
+
+
+def _touches_edge(corners: tuple[float, float, float, float], width: int, height: int, margin: float) -> bool:
+    x_min, y_min, x_max, y_max = corners
+    return x_min <= margin or y_min <= margin or x_max >= width - margin or y_max >= height - margin
+
+
+def _occluded_at_a_side(
+    corners: tuple[float, float, float, float], depth: np.ndarray, front_depth: float, config: PartialViewConfig
+) -> bool:
+    """Whether, beside the left, right or top side of the box, the depth is clearly nearer than the object's front."""
+    height, width = depth.shape
+    x_min, y_min, x_max, y_max = (int(round(value)) for value in corners)
+    x_min, x_max = max(x_min, 0), min(x_max, width)
+    y_min, y_max = max(y_min, 0), min(y_max, height)
+    if x_max <= x_min or y_max <= y_min:
+        return False
+    strip = config.strip_width
+    sides = (
+        depth[y_min:y_max, max(x_min - strip, 0):x_min],  # left
+        depth[y_min:y_max, x_max:min(x_max + strip, width)],  # right
+        depth[max(y_min - strip, 0):y_min, x_min:x_max],  # above
+    )
+    nearer_than = front_depth - config.occluder_margin
+    for side in sides:
+        values = side[np.isfinite(side) & (side > 0.0)]
+        if values.size and float(np.median(values)) < nearer_than:
+            return True
+    return False

@@ -1,0 +1,127 @@
+"""Partial views and large objects: a view that shows part of an object must not move its anchor
+to the part's middle, nor make a second anchor of it."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.features import extent_slack
+from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
+from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
+from merlin2_sailor.errors import ConfigurationError
+
+from .anchoring_scenes import PerceptMaker, SceneObject, camera_view, flat_depth
+
+#: A 1.6 m long bicycle standing along +y, 3 m ahead of the camera at the origin (looking along +x).
+BICYCLE = SceneObject("bicycle", "bicycle", (3.0, 0.0, 0.5), (0.35, 1.6, 1.0))
+MIDDLE_BOX = BoundingBox2D.from_corners(60.0, 40.0, 100.0, 80.0)  # well inside the 160 x 120 image
+EDGE_BOX = BoundingBox2D.from_corners(0.0, 40.0, 30.0, 80.0)  # cut by the left edge
+
+
+def view_of(maker: PerceptMaker, item: SceneObject, stamp: float, box: BoundingBox2D,
+            centre: tuple[float, float, float] | None = None, size: tuple[float, float, float] | None = None):
+    percept = maker.percept(item, stamp, position=centre, with_embedding=False)
+    return dataclasses.replace(percept, box=box, size=np.asarray(size or item.size, dtype=np.float64))
+
+
+def test_a_box_at_the_image_edge_is_a_partial_view_and_one_inside_is_not(maker) -> None:
+    percepts = [view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), view_of(maker, BICYCLE, 0.0, EDGE_BOX)]
+    assert partial_views(percepts, camera_view(), PartialViewConfig()) == [False, True]
+    assert partial_views(percepts, None, PartialViewConfig()) == [False, False]  # no camera, no knowing
+
+
+def test_a_nearer_surface_beside_the_box_makes_a_partial_view_and_the_floor_below_does_not(maker) -> None:
+    cup = SceneObject("cup", "cup", (3.0, 0.0, 1.0))
+    percept = view_of(maker, cup, 0.0, MIDDLE_BOX)
+    depth = flat_depth(5.0)
+    assert partial_views([percept], camera_view(depth=depth), PartialViewConfig()) == [False]
+    beside = depth.copy()
+    beside[40:80, 55:60] = 1.5  # a door frame just left of the box, much nearer than the cup
+    assert partial_views([percept], camera_view(depth=beside), PartialViewConfig()) == [True]
+    below = depth.copy()
+    below[80:85, 60:100] = 2.9  # what the cup stands on, just below it and a little nearer
+    assert partial_views([percept], camera_view(depth=below), PartialViewConfig()) == [False]
+    no_depth = flat_depth(np.nan)
+    assert partial_views([percept], camera_view(depth=no_depth), PartialViewConfig()) == [False]
+
+
+def test_partial_view_configuration_is_checked() -> None:
+    with pytest.raises(ConfigurationError, match="occluder_margin"):
+        PartialViewConfig(occluder_margin=0.0)
+    with pytest.raises(ConfigurationError, match="strip_width"):
+        PartialViewConfig(strip_width=0)
+
+
+def test_a_much_smaller_view_of_a_large_object_seen_whole_is_partial(maker) -> None:
+    anchor = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), None,
+                                 AnchoringConfig().fusion)
+    end_on = view_of(maker, BICYCLE, 1.0, MIDDLE_BOX, size=(0.35, 0.3, 1.0))
+    assert smaller_than_known(end_on, anchor)
+    assert not smaller_than_known(view_of(maker, BICYCLE, 1.0, MIDDLE_BOX), anchor)
+    mug = SceneObject("mug", "cup", (3.0, 0.0, 0.8))
+    mug_anchor = Anchor.from_percept("cup_1", view_of(maker, mug, 0.0, MIDDLE_BOX), None, AnchoringConfig().fusion)
+    tiny = view_of(maker, mug, 1.0, MIDDLE_BOX, size=(0.03, 0.03, 0.1))
+    assert not smaller_than_known(tiny, mug_anchor)  # small objects: noise, not a partial view
+
+
+def test_the_extent_slack_forgives_half_of_what_exceeds_a_small_object() -> None:
+    np.testing.assert_allclose(extent_slack(np.array([[0.1, 0.1, 0.1], [0.35, 1.6, 1.0], [0.3, 0.3, 2.0]])),
+                               [0.0, 0.65, 0.0])
+
+
+def test_partial_views_neither_duplicate_a_large_object_nor_drag_its_anchor(make_anchoring, maker) -> None:
+    anchoring = make_anchoring()
+    camera = camera_view()
+    for frame in range(3):  # whole views
+        anchoring.process([view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX)], camera, frame * 0.1)
+    [bicycle] = anchoring.anchors
+    assert bicycle.state is AnchorState.CONFIRMED
+    # Seen end-on past a door frame, many times: only the near end, 0.6 m from the middle.
+    near_end = (3.0, -0.6, 0.5)
+    for frame in range(3, 60):
+        result = anchoring.process(
+            [view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX, centre=near_end, size=(0.35, 0.4, 1.0))],
+            camera, frame * 0.1,
+        )
+        assert result.percept_symbols == (bicycle.symbol,), f"frame {frame}: a second bicycle"
+    assert len(anchoring) == 1
+    assert np.linalg.norm(bicycle.position - np.array(BICYCLE.position)) < 0.05
+    assert bicycle.size[1] == pytest.approx(1.6, rel=0.05)
+
+
+def test_without_the_extent_slack_the_same_near_end_would_be_a_new_anchor(maker) -> None:
+    """What the slack is for: the rule matcher alone puts 0.6 m beyond its tolerance."""
+    small = SceneObject("box", "bicycle", (3.0, 0.0, 0.5), (0.3, 0.3, 1.0))
+    anchoring = Anchoring()
+    camera = camera_view()
+    for frame in range(3):
+        anchoring.process([view_of(maker, small, frame * 0.1, MIDDLE_BOX)], camera, frame * 0.1)
+    result = anchoring.process([view_of(maker, small, 0.3, MIDDLE_BOX, centre=(3.0, -0.6, 0.5))], camera, 0.3)
+    assert result.acquired
+
+
+def test_an_anchor_acquired_from_a_cut_off_view_moves_to_its_first_whole_view(make_anchoring, maker) -> None:
+    anchoring = make_anchoring()
+    camera = camera_view()
+    anchoring.process([view_of(maker, BICYCLE, 0.0, EDGE_BOX, centre=(3.0, 0.5, 0.5), size=(0.35, 0.5, 1.0))],
+                      camera, 0.0)
+    anchoring.process([view_of(maker, BICYCLE, 0.1, MIDDLE_BOX)], camera, 0.1)
+    [bicycle] = anchoring.anchors
+    assert np.linalg.norm(bicycle.position - np.array(BICYCLE.position)) < 0.05
+    assert bicycle.whole_views == 1
+
+
+def test_whole_views_survive_a_snapshot(maker) -> None:
+    anchor = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), None,
+                                 AnchoringConfig().fusion)
+    assert anchor_from_dict(anchor_to_dict(anchor)).whole_views == 1
+    legacy = anchor_to_dict(anchor)
+    del legacy["whole_views"]  # a snapshot saved before the field existed
+    assert anchor_from_dict(legacy).whole_views == 0
+
