@@ -17,6 +17,7 @@ from rclpy.node import Node
 
 from merlin2_sailor.errors import KnowledgeError, SailorError
 from merlin2_sailor.knowledge import KnowledgeBase, Proposition
+from merlin2_sailor_behaviors.actions.domain import ROBOT_AT
 from merlin2_sailor_behaviors.planning import (
     Dispatcher,
     DispatcherConfig,
@@ -70,7 +71,10 @@ class MissionSession:
         self._canceled = threading.Event()
 
     def wait_until_ready(self) -> None:
-        """Wait for the knowledge base and the behaviours' actions and servers.
+        """Wait for the knowledge base, the behaviours' actions and servers, and the robot's place.
+
+        Every plan starts from where the robot is: planning before the behaviors node has
+        declared ``robot_at`` finds no plan and spends the planner's whole timeout learning so.
 
         Each action's client is made once and kept until :meth:`close`: destroying an rclpy
         action client while another thread spins its node can crash that executor.
@@ -87,7 +91,11 @@ class MissionSession:
                         self._clients[name] = PddlActionBehaviour(
                             self._node, name, f"{self._config.behaviors_prefix.rstrip('/')}/{name}")
                     unserved = sorted(name for name in wanted if not self._clients[name].server_is_ready())
-                    if not unserved:
+                    robot_placed = any(fact.predicate == ROBOT_AT and not fact.is_goal
+                                       for fact in self._store.propositions.get_all())
+                    if not unserved and not robot_placed:
+                        last_problem = f"no {ROBOT_AT} fact yet: the behaviors node has not placed the robot"
+                    elif not unserved:
                         self._behaviours = {name: self._clients[name] for name in sorted(wanted)}
                         self._say(f"ready: actions {', '.join(self._behaviours)}")
                         return

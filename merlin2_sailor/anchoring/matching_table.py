@@ -14,7 +14,8 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    and anchors keep galleries of past embeddings, never re-embedded;
 3. **tracker continuity, decided by one rule**: a percept whose (non-empty) tracker id continues
    exactly one CONFIRMED anchor of the same class, last seen at most ``continuation_maximum_age``
-   ago, not gated and at most ``continuation_maximum_distance`` from it, is taken as that
+   ago, not gated, at most ``continuation_maximum_distance`` from it and not clearly farther
+   from it than from another anchor of the class (``continuation_nearest_margin``), is taken as that
    anchor's continuation: its other pairs are not scored
    (which is what spares its crop from the backbone) and the pair scores
    ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
@@ -60,7 +61,9 @@ class MatchingTableConfig:
     (about a tracker's buffer); ``continuation_maximum_distance`` (m): how far from a continued
     anchor a percept may be for its tracker id to count at all (a 2D tracker swaps ids between
     nearby objects of one class when the camera turns fast: an id that lands half a metre or more
-    away is a swap, not the same object); ``gated_score``: the penalty gated pairs hold (negative);
+    away is a swap, not the same object); ``continuation_nearest_margin`` (m): an id does not count
+    either when another anchor of the class is nearer the percept than the continued one by more
+    than this (the id swapped to a neighbour); ``gated_score``: the penalty gated pairs hold (negative);
     ``search_score_cap``: the most a pair with an anchor being searched for (an expectation with a
     radius) can score, below an in-place match and a tracker continuation, so that a look-alike
     anchored where the search looks keeps its own percept."""
@@ -72,6 +75,7 @@ class MatchingTableConfig:
     tracker_continuity_score: float = 0.9
     continuation_maximum_age: float = 1.0
     continuation_maximum_distance: float = 0.5
+    continuation_nearest_margin: float = 0.1
     gated_score: float = -1.0
     search_score_cap: float = 0.7
 
@@ -94,6 +98,10 @@ class MatchingTableConfig:
             )
         if not (0.0 < self.search_score_cap <= 1.0):
             raise ConfigurationError(f"table search_score_cap must be in (0, 1], got {self.search_score_cap}.")
+        if not (math.isfinite(self.continuation_nearest_margin) and self.continuation_nearest_margin >= 0.0):
+            raise ConfigurationError(
+                f"table continuation_nearest_margin must be >= 0 metres, got {self.continuation_nearest_margin}."
+            )
         if not (math.isfinite(self.continuation_maximum_distance) and self.continuation_maximum_distance > 0.0):
             raise ConfigurationError(
                 f"table continuation_maximum_distance must be a positive number of metres, "
@@ -155,11 +163,17 @@ class MatchingTableBuilder:
         continuations = tracker_continuations(columns.tracker_ids, anchor_columns.tracker_ids) & same_class & ~gated
         candidate_rows, candidate_columns = np.nonzero(continuations)
         if candidate_rows.size:
-            jump = np.linalg.norm(
-                columns.positions[candidate_rows] - anchor_columns.positions[candidate_columns], axis=1
+            distance = np.linalg.norm(
+                columns.positions[:, np.newaxis, :] - anchor_columns.positions[np.newaxis, :, :], axis=2
             )
+            jump = distance[candidate_rows, candidate_columns]
             too_far = jump > self.config.continuation_maximum_distance
-            continuations[candidate_rows[too_far], candidate_columns[too_far]] = False
+            # An id that lands on an object while another of its class lies clearly nearer the
+            # percept has swapped between neighbours (books on a shelf, as the camera turns).
+            nearest = np.where(same_class & ~gated, distance, np.inf)[candidate_rows].min(axis=1)
+            swapped = jump > nearest + self.config.continuation_nearest_margin
+            not_continued = too_far | swapped
+            continuations[candidate_rows[not_continued], candidate_columns[not_continued]] = False
         confirmed = np.array([anchor.state is AnchorState.CONFIRMED for anchor in anchors], dtype=bool)
         age = columns.stamps[:, np.newaxis] - anchor_columns.last_seen[np.newaxis, :]
         eligible = continuations & confirmed[np.newaxis, :] & (age <= self.config.continuation_maximum_age)

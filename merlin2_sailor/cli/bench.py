@@ -38,6 +38,10 @@ BENCHMARKS = {
     "anchoring_scale": ("bench_anchoring_scale.py", "anchoring per frame and memory as far anchors pile up"),
     "pipeline": ("bench_pipeline.py", "end-to-end latency over DDS at 15 and 30 Hz, memory over a long run"),
     "load": ("bench_load.py", "50 detections at 30 Hz then 90 Hz over DDS: memory, queues, drops"),
+    "world_render": ("bench_world_render.py", "the simulated house's frame (render, depth, detections) vs 15 Hz"),
+    "network_split": ("bench_network_split.py",
+                      "latency and throughput across the robot/laptop split, impaired link vs clean "
+                      "(needs network namespaces; skipped with the reason where they cannot be made)"),
 }
 #: Benchmarks that take --duration (their long phase) and write the nodes' output with --node-log.
 GRAPH_BENCHMARKS = ("pipeline", "load")

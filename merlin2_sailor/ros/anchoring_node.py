@@ -15,6 +15,7 @@ for occlusion), ``robot_pose`` (for carried objects); out ``anchors`` (latched, 
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from collections.abc import Sequence
 from typing import Any
@@ -36,7 +37,7 @@ from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, Persistence
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.anchoring.state_file import AnchoringStateFile
 from merlin2_sailor.anchoring.symbols import SymbolCounter
-from merlin2_sailor.anchoring.visibility import CameraView
+from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
 from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
@@ -102,6 +103,12 @@ class AnchoringNode(Node):
             self, "forget_tentative_after", 2.0,
             "Seconds a never-confirmed anchor (often a false detection) survives not being seen where it should be.",
             minimum=0.0, maximum=3600.0)
+        default_visibility = VisibilityConfig()
+        visible_range = declare_parameter(
+            self, "visible_range", default_visibility.frustum.far,
+            "Farthest an anchor may be (m) and still be expected in view; keep it within the percept "
+            "generator's maximum_depth, or anchors beyond it are marked missing for not being perceived.",
+            minimum=0.3, maximum=100.0)
         stamp_tolerance = declare_parameter(
             self, "stamp_tolerance", 0.05,
             "Largest gap (s) between percepts and the camera pose / depth they are judged with.",
@@ -114,8 +121,12 @@ class AnchoringNode(Node):
         if saved and saved.owned_objects:
             self._symbols.note_used(saved.owned_objects)  # symbols the knowledge base has seen
         self._anchoring = Anchoring(
-            AnchoringConfig(world_frame=world_frame, lifecycle=LifecycleConfig(
-                forget_after=forget_after, forget_tentative_after=forget_tentative_after)),
+            AnchoringConfig(
+                world_frame=world_frame,
+                lifecycle=LifecycleConfig(forget_after=forget_after, forget_tentative_after=forget_tentative_after),
+                visibility=dataclasses.replace(
+                    default_visibility, frustum=dataclasses.replace(default_visibility.frustum, far=visible_range)),
+            ),
             matcher=self._make_matcher(matcher, weights, backbone),
             # The network compares crops, so it needs them embedded; the rules never look at them.
             embedder=self._make_embedder(backbone) if matcher == "network" else None,

@@ -156,11 +156,22 @@ def test_no_shortcut_without_a_clear_continuation(maker, state, age, class_name,
 
 def test_two_anchors_continuing_one_id_are_no_shortcut(maker):
     first = anchor_of(maker, CUP, "cup_1", tracker_id="5")
-    second = anchor_of(maker, moved(CUP, (0.0, 0.2, 0.0)), "cup_2", tracker_id="5")
+    second = anchor_of(maker, moved(CUP, (0.0, 0.05, 0.0)), "cup_2", tracker_id="5")
     percept = maker.percept(CUP, 0.1, tracker_id="5")
     table = MatchingTableBuilder(RuleMatcher()).build([percept], index_of(first, second))
     assert table.shortcut.tolist() == [False]
     assert np.all(table.scores[0] >= MatchingTableConfig().tracker_continuity_score)  # both raised to the floor
+
+
+def test_an_id_that_swapped_to_a_neighbour_does_not_pull_the_percept_off_its_own_anchor(maker):
+    """Books 0.3 m apart on a shelf: the tracker gave book B's percept the id of book A's anchor."""
+    book_a = anchor_of(maker, moved(CUP, (0.0, 0.3, 0.0)), "cup_1", tracker_id="7")
+    book_b = anchor_of(maker, CUP, "cup_2", tracker_id="8")
+    percept_of_b = maker.percept(CUP, 0.1, tracker_id="7")
+    table = MatchingTableBuilder(RuleMatcher()).build([percept_of_b], index_of(book_a, book_b))
+    assert table.shortcut.tolist() == [False] and not table.continuations.any()
+    column = {anchor.symbol: index for index, anchor in enumerate(table.anchors)}
+    assert table.scores[0, column["cup_2"]] > table.scores[0, column["cup_1"]]
 
 
 def test_each_crop_is_embedded_once_in_one_call(maker):
