@@ -31,11 +31,11 @@ from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation, ExpectationKind
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
 from merlin2_sailor.anchoring.gallery import gallery_similarity
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_expected_but_unseen, after_sighting, expire
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.matching_table import Embedder, MatchingTableBuilder, MatchingTableConfig, with_embeddings
+from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
 from merlin2_sailor.anchoring.percept import Percept
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import SNAPSHOT_FORMAT, SNAPSHOT_VERSION, anchor_from_dict, anchor_to_dict
