@@ -76,7 +76,8 @@ class MissionDemoNode(Node):
     def __init__(self, **options: Any) -> None:
         super().__init__("mission_demo", **options)
         self._folder = Path(declare_parameter(
-            self, "report_folder", "reports/demo", "Folder of the report (created).")).expanduser()
+            self, "report_folder", "~/.sailor/house/report", "Folder of the report (created when the demo runs).")
+        ).expanduser()
         self._data = Path(declare_parameter(
             self, "data_folder", "", "Where the world writes ground_truth.json (default: the report folder's parent)."
         ) or self._folder.parent).expanduser()
@@ -113,7 +114,6 @@ class MissionDemoNode(Node):
         self._frames = 0
         self._words = AnchorEventWording()
         self._initial_truth: list[TrueObject] = []
-        (self._folder / "frames").mkdir(parents=True, exist_ok=True)
         self._unsubscribe = self._store.subscribe(self._on_fact_changes)
         self.create_subscription(AnchorArray, "/anchors", self._on_anchors, LATCHED)
         self.create_subscription(AnchorEventArray, "/anchor_events", self._on_anchor_events, EVENTS)
@@ -295,6 +295,7 @@ class MissionDemoNode(Node):
         frame = annotate_frame(rgb, self._intrinsics, pose, views, caption=caption)
         self._frames += 1
         path = self._folder / "frames" / f"frame_{self._frames:04d}.png"
+        path.parent.mkdir(parents=True, exist_ok=True)
         cv2.imwrite(str(path), cv2.cvtColor(frame, cv2.COLOR_RGB2BGR))
 
     def destroy_node(self) -> None:
