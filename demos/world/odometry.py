@@ -30,7 +30,9 @@ class OdometryNoise:
     ``translation_noise`` m per sqrt(m) driven; ``rotation_noise`` rad per sqrt(rad) turned;
     ``heading_noise`` rad per sqrt(m) driven; ``scale_error`` (fraction) and ``heading_drift``
     (rad per m) are systematic, drawn once; ``localisation_position`` (m) and
-    ``localisation_heading`` (rad) are the residual error after a localiser correction.
+    ``localisation_heading`` (rad) are the residual error after a localiser correction;
+    ``localisation_period`` (s) is how often the localiser corrects while the robot moves, as AMCL
+    does against a map (0: only on arrival at a goal, so drift builds up over a whole drive).
     """
 
     translation_noise: float = 0.005
@@ -40,16 +42,19 @@ class OdometryNoise:
     heading_drift: float = 0.003
     localisation_position: float = 0.01
     localisation_heading: float = 0.005
+    localisation_period: float = 0.0
 
     FIELDS = ("translation_noise", "rotation_noise", "heading_noise", "scale_error", "heading_drift",
-              "localisation_position", "localisation_heading")
+              "localisation_position", "localisation_heading", "localisation_period")
 
     @classmethod
     def from_mapping(cls, data: Any, where: str) -> OdometryNoise:
         fields = Fields(data, where, cls.FIELDS)
         defaults = cls()
-        return cls(**{name: fields.number(name, getattr(defaults, name), minimum=0.0, maximum=1.0)
-                      for name in cls.FIELDS})
+        values = {name: fields.number(name, getattr(defaults, name), minimum=0.0, maximum=1.0)
+                  for name in cls.FIELDS if name != "localisation_period"}
+        period = fields.number("localisation_period", defaults.localisation_period, minimum=0.0, maximum=3600.0)
+        return cls(**values, localisation_period=period)
 
 
 class Odometry:

@@ -87,6 +87,7 @@ class World:
         robot = description.robot
         self.true_pose = robot.start
         self.odometry = Odometry(robot.odometry, np.random.default_rng(odometry_seed), robot.start)
+        self._since_fix = 0.0  # seconds of motion since the localiser last corrected the estimate
         self.graph = NavigationGraph(self.house, robot.radius)
         self.gripper = Gripper(robot.gripper)
         self.scenario = Scenario(description.scenario)
@@ -127,6 +128,11 @@ class World:
         before = self.true_pose
         self.true_pose = integrate(before, velocity, dt)
         self.odometry.update(before, self.true_pose, dt)
+        period = self.odometry.noise.localisation_period
+        self._since_fix += dt
+        if period > 0.0 and self._since_fix >= period:  # the localiser's periodic fix against the map
+            self.odometry.correct(self.true_pose)
+            self._since_fix = 0.0
         self.gripper.follow(self.true_pose)
         if goal.follower.done and goal.state is NavigationState.ACTIVE:
             self._arrive(goal)
