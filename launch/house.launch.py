@@ -28,7 +28,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package="merlin2_sailor", executable="anchoring",
              parameters=parameters("anchoring", state_folder=f"{data}/anchoring",
                                    knowledge_base="ros:///merlin2", grounding=grounding,
-                                   rules_maximum_sigma=0.4, visible_range=4.5),
+                                   rules_maximum_sigma=0.3, visible_range=4.5),
              remappings=[("percepts", "/camera/percepts"),
                          ("color/camera_info", "/camera/color/camera_info"),
                          ("camera_pose", "/camera/camera_pose"),
