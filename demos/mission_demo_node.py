@@ -20,7 +20,6 @@ map.png, frames/, knowledge.pddl, account.log) and exits 0 when the demo showed 
 from __future__ import annotations
 
 import json
-import logging
 import math
 import threading
 import time
@@ -62,7 +61,6 @@ from merlin2_sailor_demos.world import load_world
 from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray
 
 _STATE_NAMES = {0: "tentative", 1: "confirmed", 2: "missing", 3: "forgotten"}
-_PLANNING_LOGGER = "merlin2_sailor_behaviors.planning"
 EXPLORE_ACTIONS = ("navigation", "explore")
 FETCH_ACTIONS = ("navigation", "approach_object", "find_object")
 
@@ -124,8 +122,7 @@ class MissionDemoNode(Node):
         self.create_subscription(Image, "/camera/color/image_raw", self._on_image, SENSOR_DATA)
         self.create_timer(1.0, self._record_identities)
         self._log_handler = ForwardToRosLogger(self, say=self._say)
-        logging.getLogger(_PLANNING_LOGGER).addHandler(self._log_handler)
-        logging.getLogger(_PLANNING_LOGGER).setLevel(logging.INFO)
+        self._log_handler.attach()
         self._started = time.monotonic()
         self._worker = threading.Thread(target=self._run, name="mission-demo", daemon=True)
         self._worker.start()
@@ -317,7 +314,7 @@ class MissionDemoNode(Node):
         self._session.cancel()
         self._worker.join(timeout=10.0)
         self._session.close()
-        logging.getLogger(_PLANNING_LOGGER).removeHandler(self._log_handler)
+        self._log_handler.detach()
         self._unsubscribe()
         self._store.close()
         super().destroy_node()

@@ -204,8 +204,7 @@ class LookAround(BehaviorState):
         return SUCCEED
 
     def _record(self, target: Target) -> None:
-        place = target.name.split(" (turn", 1)[0]
-        self.context.looks.record(place, target.pose.x, target.pose.y)
+        self.context.looks.record(target.name, target.pose.x, target.pose.y)
 
 
 def place_target(context: BehaviorContext, place_name: str) -> Target:

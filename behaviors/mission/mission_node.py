@@ -9,7 +9,6 @@ and the anchor events that matter (acquired, missing, reacquired after missing, 
 
 from __future__ import annotations
 
-import logging
 import threading
 from collections.abc import Sequence
 from typing import Any
@@ -29,7 +28,6 @@ from merlin2_sailor_interfaces.msg import AnchorEventArray
 
 ROS_PREFIX = "ros://"
 _KIND_NAMES = {number: kind.value for kind, number in EVENT_KIND_TO_MESSAGE.items()}
-_PLANNING_LOGGER = "merlin2_sailor_behaviors.planning"
 
 
 def anchor_event_lines(wording: AnchorEventWording, message: AnchorEventArray) -> list[str]:
@@ -90,8 +88,7 @@ class MissionNode(Node):
         self._unsubscribe = self._store.subscribe(self._on_fact_changes)
         self.create_subscription(AnchorEventArray, "/anchor_events", self._on_anchor_events, EVENTS)
         self._log_handler = ForwardToRosLogger(self)
-        logging.getLogger(_PLANNING_LOGGER).addHandler(self._log_handler)
-        logging.getLogger(_PLANNING_LOGGER).setLevel(logging.INFO)
+        self._log_handler.attach()
         self._worker = threading.Thread(target=self._run, name="mission", daemon=True)
         self._worker.start()
 
@@ -119,7 +116,7 @@ class MissionNode(Node):
         self._session.cancel()
         self._worker.join(timeout=10.0)
         self._session.close()
-        logging.getLogger(_PLANNING_LOGGER).removeHandler(self._log_handler)
+        self._log_handler.detach()
         self._unsubscribe()
         self._store.close()
         super().destroy_node()

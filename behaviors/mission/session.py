@@ -156,6 +156,10 @@ class MissionSession:
         self._behaviours = {}
 
 
+#: The dispatcher's plan and step lines are logged under this package logger.
+PLANNING_LOGGER = "merlin2_sailor_behaviors.planning"
+
+
 class ForwardToRosLogger(logging.Handler):
     """Python logging (the dispatcher's plan and step lines) into a ROS node's logger, or into
     ``say`` when given (a running account that also keeps the lines).
@@ -167,6 +171,15 @@ class ForwardToRosLogger(logging.Handler):
         super().__init__(level=logging.INFO)
         self._logger = node.get_logger()
         self._say = say
+
+    def attach(self) -> None:
+        """Start forwarding the planning lines (INFO and up)."""
+        logger = logging.getLogger(PLANNING_LOGGER)
+        logger.addHandler(self)
+        logger.setLevel(logging.INFO)
+
+    def detach(self) -> None:
+        logging.getLogger(PLANNING_LOGGER).removeHandler(self)
 
     def emit(self, record: logging.LogRecord) -> None:
         message = self.format(record)

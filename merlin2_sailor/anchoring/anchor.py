@@ -99,7 +99,7 @@ class Anchor:
             last_seen=percept.stamp,
             last_tracker_id=percept.tracker_id,
             class_votes=vote_class({}, percept.class_name, percept.score),
-            position_variance=config.initial_variance * (config.cut_off_variance_factor if partial else 1.0),
+            position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
             whole_views=0 if partial else 1,
             gallery=None if embedding is None else add_to_gallery(None, embedding, config.gallery_size),
             visible=True,
@@ -114,7 +114,7 @@ class Anchor:
         A ``partial`` view (cut by the image's edge or an occluder, see :mod:`.partial_view`) is
         centred on the part in view: once the anchor has had a whole view, a partial one keeps it
         alive but moves and resizes it no more; before that, it is the best there is, but weighs
-        ``cut_off_variance_factor`` times less.
+        ``partial_view_variance_factor`` times less.
         """
         self.times_seen += 1
         if not partial or self.whole_views == 0:

@@ -34,7 +34,7 @@ class FusionConfig:
     ``initial_variance`` (m^2): the variance of a newly acquired anchor's position.
     ``size_smoothing``: the weight of a new size measurement once the anchor is well known.
     ``gallery_size``: how many recent embeddings an anchor keeps.
-    ``cut_off_variance_factor``: how many times less a partial view (cut by the image's edge or
+    ``partial_view_variance_factor``: how many times less a partial view (cut by the image's edge or
     an occluder, see :mod:`.partial_view`) moves an anchor than a whole one; its centre and size
     are those of the part in view."""
 
@@ -43,7 +43,7 @@ class FusionConfig:
     initial_variance: float = 0.01
     size_smoothing: float = 0.2
     gallery_size: int = 4
-    cut_off_variance_factor: float = 100.0
+    partial_view_variance_factor: float = 100.0
 
     def __post_init__(self) -> None:
         for name in ("measurement_variance", "initial_variance"):
@@ -56,9 +56,9 @@ class FusionConfig:
             )
         if not (0.0 < self.size_smoothing <= 1.0):
             raise ConfigurationError(f"fusion size_smoothing must be in (0, 1], got {self.size_smoothing}.")
-        if not (math.isfinite(self.cut_off_variance_factor) and self.cut_off_variance_factor >= 1.0):
+        if not (math.isfinite(self.partial_view_variance_factor) and self.partial_view_variance_factor >= 1.0):
             raise ConfigurationError(
-                f"fusion cut_off_variance_factor must be at least 1, got {self.cut_off_variance_factor}."
+                f"fusion partial_view_variance_factor must be at least 1, got {self.partial_view_variance_factor}."
             )
         if self.gallery_size < 1:
             raise ConfigurationError(f"fusion gallery_size must be at least 1, got {self.gallery_size}.")
@@ -73,9 +73,9 @@ def fuse_position(
     partial: bool = False,
 ) -> tuple[np.ndarray, float]:
     """Return the fused (position, variance) after ``elapsed`` seconds unseen and one measurement
-    (``partial``: of a partial view, trusted ``cut_off_variance_factor`` times less)."""
+    (``partial``: of a partial view, trusted ``partial_view_variance_factor`` times less)."""
     predicted_variance = variance + config.drift_variance_rate * max(0.0, elapsed)
-    measurement_variance = config.measurement_variance * (config.cut_off_variance_factor if partial else 1.0)
+    measurement_variance = config.measurement_variance * (config.partial_view_variance_factor if partial else 1.0)
     gain = predicted_variance / (predicted_variance + measurement_variance)
     fused = position + gain * (np.asarray(measurement, dtype=np.float64) - position)
     return fused, (1.0 - gain) * predicted_variance

@@ -4,7 +4,7 @@ A percept's position is the middle of the object's points the camera saw. When p
 object is outside the picture, or hidden behind a door frame or a table, that middle is the
 middle of the part in view, off by up to half the object's extent: a television seen past a
 door frame is anchored at its near end. Such a view still proves the object is there (it keeps
-the anchor alive), but it should barely move the anchor (see ``FusionConfig.cut_off_variance_factor``).
+the anchor alive), but it should barely move the anchor (see ``FusionConfig.partial_view_variance_factor``).
 
 Two tests, both cheap: the 2D box comes within ``edge_margin`` pixels of the image's edge; or,
 with a depth image, a strip of pixels just outside the left, right or top side of the box is

@@ -39,10 +39,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help=f"where the run's data and report go (default: {DEFAULT_OUTPUT}); emptied of a previous "
              "demo's files first",
     )
-    parser.add_argument(
-        "--grace-period", type=float, default=10.0, metavar="SECONDS",
-        help="how long nodes get to shut down at the end before they are terminated (default 10)",
-    )
+    launch_command.add_grace_period_argument(parser)
     parser.set_defaults(run=run)
 
 

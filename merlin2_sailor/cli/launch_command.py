@@ -32,11 +32,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--duration", type=float, default=None, metavar="SECONDS",
         help="stop the launch after this many seconds (default: run until Ctrl-C)",
     )
+    add_grace_period_argument(parser)
+    parser.set_defaults(run=run)
+
+
+def add_grace_period_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--grace-period", type=float, default=10.0, metavar="SECONDS",
-        help="how long nodes get to shut down after Ctrl-C before they are terminated (default 10)",
+        help="how long nodes get to shut down, at Ctrl-C or the end, before they are terminated (default 10)",
     )
-    parser.set_defaults(run=run)
 
 
 def run(arguments: argparse.Namespace) -> int:

@@ -263,10 +263,9 @@ def _estimate_one(
             )
         window_mask = mask[window.slices].astype(bool, copy=False)
 
-    center_depth = _robust_depth(window_range, window_mask, config)
+    center_depth, coverage = _robust_depth(window_range, window_mask, config)
     if center_depth is None:
         return _too_few_pixels(index, window_range, window_mask, config, band_count=0, center_depth=math.nan)
-    coverage = _central_coverage(window_range, window_mask, config)
     if coverage < config.minimum_depth_coverage:
         too_few = _too_few_pixels(index, window_range, window_mask, config, band_count=0, center_depth=center_depth)
         if too_few.reason is RejectionReason.TOO_FEW_DEPTH_PIXELS:
@@ -383,40 +382,39 @@ def _central_region(window_shape: tuple[int, ...], config: Box3DConfig) -> tuple
     )
 
 
-def _central_coverage(window_range: np.ndarray, window_mask: np.ndarray | None, config: Box3DConfig) -> float:
-    """The fraction of the central region's pixels (inside the mask, if any) with usable depth."""
-    if config.minimum_depth_coverage <= 0.0:
-        return 1.0
-    central = _central_region(window_range.shape, config)
-    usable = _usable(window_range[central], config)
-    if window_mask is None:
-        return float(np.count_nonzero(usable)) / max(usable.size, 1)
-    inside = window_mask[central]
-    inside_count = int(np.count_nonzero(inside))
-    if inside_count == 0:
-        return 1.0  # the mask misses the centre: coverage says nothing there; the pixel counts decide
-    return float(np.count_nonzero(usable & inside)) / inside_count
-
-
-def _robust_depth(window_range: np.ndarray, window_mask: np.ndarray | None, config: Box3DConfig) -> float | None:
-    """Median depth of the central region, or of the whole box when the centre has too few readings.
+def _robust_depth(
+    window_range: np.ndarray, window_mask: np.ndarray | None, config: Box3DConfig
+) -> tuple[float | None, float]:
+    """Median depth of the central region, or of the whole box when the centre has too few
+    readings; and the central region's coverage: the fraction of its pixels (inside the mask, if
+    any) with usable depth, read from the same sample.
 
     Large regions are sampled on a regular grid of at most ``maximum_median_samples`` pixels: the
     median of a few thousand pixels of one surface is the same to within millimetres, and the
-    selection it needs grows with the number of pixels. Returns None when the box has no usable
-    depth at all.
+    selection it needs grows with the number of pixels. The depth is None when the box has no
+    usable depth at all.
     """
     central = _central_region(window_range.shape, config)
-    central_values = _usable_values(window_range, window_mask, central, config)
+    values = window_range[central]
+    usable = _usable(values, config)
+    if window_mask is None:
+        coverage = float(np.count_nonzero(usable)) / max(usable.size, 1)
+    else:
+        inside = window_mask[central]
+        usable &= inside
+        inside_count = int(np.count_nonzero(inside))
+        # A mask that misses the centre says nothing about coverage there; the pixel counts decide.
+        coverage = float(np.count_nonzero(usable)) / inside_count if inside_count else 1.0
+    central_values = values[usable]
     if central_values.size >= config.minimum_central_pixels:
-        return float(np.median(central_values, overwrite_input=True))
+        return float(np.median(central_values, overwrite_input=True)), coverage
     stride = max(1, math.ceil(math.sqrt(window_range.size / config.maximum_median_samples)))
     whole_values = _usable_values(window_range, window_mask, (slice(None, None, stride),) * 2, config)
     if whole_values.size == 0 and stride > 1:  # the regular sample missed the few usable pixels
         whole_values = _usable_values(window_range, window_mask, (slice(None), slice(None)), config)
     if whole_values.size == 0:
-        return None
-    return float(np.median(whole_values, overwrite_input=True))
+        return None, coverage
+    return float(np.median(whole_values, overwrite_input=True)), coverage
 
 
 def _usable_values(

@@ -203,12 +203,16 @@ def masks(draw: st.DrawFn) -> Mask:
     return Mask(height=height, width=width, data=points)
 
 
+def draw_box(draw: st.DrawFn, box) -> None:
+    """Fill a BoundingBox2D message with any centre, rotation and size, however wrong."""
+    box.center.position.x, box.center.position.y, box.center.theta = draw(pixels), draw(pixels), draw(thetas)
+    box.size.x, box.size.y = draw(extents), draw(extents)
+
+
 @st.composite
 def detections(draw: st.DrawFn) -> Detection:
     message = Detection(class_id=draw(int32s), class_name=draw(names), score=draw(scores), id=draw(names))
-    box = message.bbox
-    box.center.position.x, box.center.position.y, box.center.theta = draw(pixels), draw(pixels), draw(thetas)
-    box.size.x, box.size.y = draw(extents), draw(extents)
+    draw_box(draw, message.bbox)
     if draw(st.booleans()):
         message.mask = draw(masks())
     return message
@@ -224,9 +228,7 @@ def percepts(draw: st.DrawFn) -> Percept:
     message = Percept(class_name=draw(names), class_id=draw(int32s), score=draw(scores), tracker_id=draw(names),
                       stamp=draw(stamps()), position=Point(x=draw(metres), y=draw(metres), z=draw(metres)),
                       size=Vector3(x=draw(extents), y=draw(extents), z=draw(extents)))
-    box = message.bbox
-    box.center.position.x, box.center.position.y, box.center.theta = draw(pixels), draw(pixels), draw(thetas)
-    box.size.x, box.size.y = draw(extents), draw(extents)
+    draw_box(draw, message.bbox)
     if draw(st.booleans()):
         message.crop = draw(images())
     return message
