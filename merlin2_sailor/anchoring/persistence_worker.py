@@ -56,6 +56,9 @@ class PersistenceWorker:
         self._open_knowledge_base = open_knowledge_base
         self._grounding = grounding
         self._owned = owned_objects
+        # Objects a failed batch tried to create: the knowledge base may hold them (see
+        # KnowledgeSync.unconfirmed_objects); the rebuilt sync adopts those it finds.
+        self._unconfirmed: frozenset[str] = frozenset()
         self._sync_period, self._save_period = sync_period, save_period
         self._log = log
         self._store: KnowledgeBase | None = None
@@ -94,9 +97,9 @@ class PersistenceWorker:
         while the restarted node anchored the same things again under new symbols.
         """
         anchors = self._copy_anchors()
-        owned_before = self._owned
+        owned_before = self._owned | self._unconfirmed
         self._sync_knowledge_base(anchors.views)
-        created = not self._owned <= owned_before
+        created = not self._owned | self._unconfirmed <= owned_before
         if force_save or created or time.monotonic() >= self._next_save:
             self._save(anchors)
 
@@ -105,7 +108,8 @@ class PersistenceWorker:
             return
         self._next_save = time.monotonic() + self._save_period
         try:
-            self._state_file.save_anchors(anchors.snapshot(), self._owned)
+            # The unconfirmed too: a node restarted from this file adopts those the store holds.
+            self._state_file.save_anchors(anchors.snapshot(), self._owned | self._unconfirmed)
         except OSError as error:
             self._log("error", f"cannot save anchors to {self._state_file.folder}: {error}")
 
@@ -127,15 +131,18 @@ class PersistenceWorker:
             if self._store is None:
                 self._store = self._open_knowledge_base()
             if self._sync is None:
-                self._sync = KnowledgeSync(self._store, self._grounding, owned=self._owned)
+                self._sync = KnowledgeSync(self._store, self._grounding,
+                                           owned=self._owned | self._unconfirmed)
             self._sync.sync(views)
             self._owned = self._sync.owned_objects
+            self._unconfirmed = frozenset()
         except SailorError as error:
             if self._knowledge_base_ok is not False:
                 self._log("error", f"knowledge base not updated, retrying every "
                                    f"{self._sync_period:g} s; anchors are kept: {error}")
             self._knowledge_base_ok = False
             if self._sync is not None:
+                self._unconfirmed |= self._sync.unconfirmed_objects
                 self._sync.close()
             self._sync = None  # rebuilt from what the store really holds once it answers
             return

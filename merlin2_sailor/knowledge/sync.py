@@ -55,6 +55,9 @@ class KnowledgeSync:
         self._declarations_missing = True
         self._grounded: dict[str, GroundedAnchor] = {}
         self._created: set[str] = set()
+        # Objects whose creation was sent in a batch that failed: the store may have applied it
+        # and lost only the answer (a remote KB killed mid-request), so it may hold them.
+        self._unconfirmed: set[str] = set()
         # Objects that existed before the sync created any: reading them once, at start, is
         # the only read the sync makes; afterwards store events keep these sets current.
         self._foreign_objects = {pddl_object.name for pddl_object in store.objects.get_all()}
@@ -69,6 +72,16 @@ class KnowledgeSync:
     def owned_objects(self) -> frozenset[str]:
         """The objects this sync created and will delete when their anchors go; persist them."""
         return frozenset(self._created)
+
+    @property
+    def unconfirmed_objects(self) -> frozenset[str]:
+        """Objects this sync tried to create in a batch that failed and has not created since.
+
+        The store may hold them anyway (it applied the batch, the answer was lost). A sync rebuilt
+        after the failure must be given them as ``owned``: it adopts those the store holds, where
+        it would otherwise take them for someone else's objects and never delete them.
+        """
+        return frozenset(self._unconfirmed - self._created)
 
     def _adopt(self, name: str) -> None:
         stored = self._store.objects.get(name)
@@ -123,6 +136,7 @@ class KnowledgeSync:
         except BaseException:
             self._grounded = previous_grounded
             self._created -= plan.created_objects
+            self._unconfirmed |= plan.created_objects
             raise
         self._declarations_missing = False
         for name in previous_grounded.keys() - plan.grounded.keys():

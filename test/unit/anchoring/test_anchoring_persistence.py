@@ -25,11 +25,12 @@ def anchor(symbol: str, x: float) -> Anchor:
 
 
 class FlakyStore:
-    """A knowledge base that can be made to fail, and restarted empty."""
+    """A knowledge base that can be made to fail, lose its answers, and restart empty."""
 
     def __init__(self) -> None:
         self.store = open_store("memory")
         self.down = False
+        self.answers_lost = False  # applies a batch, then fails as if killed before answering
         self.opened = 0
 
     def open(self):
@@ -40,6 +41,11 @@ class FlakyStore:
             def __getattr__(self, name):
                 if outer.down:
                     raise KnowledgeError("knowledge base unreachable")
+                if name == "apply" and outer.answers_lost:
+                    def apply_then_die(changes):
+                        outer.store.apply(changes)
+                        raise KnowledgeError("the knowledge base did not answer")
+                    return apply_then_die
                 return getattr(outer.store, name)
 
         return Proxy()
@@ -128,3 +134,27 @@ def test_a_sync_that_creates_objects_saves_the_state_at_once(tmp_path) -> None:
     assert "book_1" in state.load().owned_objects
     worker.step()  # nothing new: no save needed (and none made: the file is unchanged)
     assert len(state.load().snapshot["anchors"]) == 2
+
+
+def test_objects_created_by_a_batch_whose_answer_was_lost_stay_ours(tmp_path) -> None:
+    """A knowledge base killed after committing a batch, before answering: its objects are still
+    the anchors' own, saved as such, and deleted with their anchor later (none left behind)."""
+    kb = FlakyStore()
+    anchors = [anchor("cup_1", 1.0)]
+    state = AnchoringStateFile(tmp_path)
+    worker = PersistenceWorker(lambda: AnchorsCopy(views_of(anchors), lambda: {"anchors": [a.symbol for a in anchors]}),
+                               state, kb.open, GROUNDING, save_period=3600.0)
+    worker.step()
+    anchors.append(anchor("book_1", 1.2))
+    kb.answers_lost = True
+    worker.step()
+    assert kb.store.objects.get("book_1") is not None  # committed, but the worker never heard so
+    assert "book_1" in state.load().owned_objects  # a node restarted now would adopt it
+    kb.answers_lost = False
+    worker.step()  # the rebuilt sync finds book_1 in the store
+    assert worker.owned_objects == {"cup_1", "book_1"}
+    assert state.load().owned_objects == {"cup_1", "book_1"}
+    anchors.pop()  # book_1 forgotten
+    worker.step()
+    assert kb.store.objects.get("book_1") is None
+    assert [o.name for o in kb.store.objects.get_all() if o.name in ("cup_1", "book_1")] == ["cup_1"]
