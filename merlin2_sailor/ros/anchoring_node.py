@@ -27,7 +27,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
-from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_view import views_of
 from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig, AnchoringResult
 from merlin2_sailor.anchoring.events import AnchorEventKind
@@ -336,14 +336,19 @@ class AnchoringNode(Node):
             return
         with self._lock:
             class_names = {anchor.symbol: anchor.class_name for anchor in self._anchoring.anchors}
+            tentative = {anchor.symbol for anchor in self._anchoring.anchors
+                         if anchor.state is AnchorState.TENTATIVE}
         class_names.update({anchor.symbol: anchor.class_name for anchor in result.forgotten})
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
         self._events_publisher.publish(events_to_message(result.events, class_names, header))
         for event in result.events:  # a running account; reacquisitions would flood it
             if event.kind is not AnchorEventKind.REACQUIRED:
+                # Tentative said out loud: a false detection makes one, and it goes unconfirmed.
+                status = " [tentative]" if (event.kind is AnchorEventKind.ACQUIRED
+                                            and event.symbol in tentative) else ""
                 details = ", ".join(f"{key}={value}" for key, value in event.details.items())
                 self.get_logger().info(
-                    f"{event.kind.value} {event.symbol} ({class_names.get(event.symbol, '?')})"
+                    f"{event.kind.value} {event.symbol} ({class_names.get(event.symbol, '?')}){status}"
                     + (f": {details}" if details else ""))
         self._publish_state()
 

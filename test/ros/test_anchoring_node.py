@@ -8,6 +8,7 @@ frame; the camera is 1 m above the origin looking along +x (as rgbd_player's def
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import time
@@ -129,6 +130,9 @@ def test_anchoring_over_dds_with_the_knowledge_base_and_a_restart(tmp_path, ros_
         time.sleep(0.6)  # a save period or two: the state file holds both anchors
         anchoring.process.kill()  # SIGKILL: no chance to save anything more
         anchoring.stop()
+        # The running account says which new anchors are still unconfirmed (false detections are).
+        assert re.search(r"acquired cup_1 \(cup\) \[tentative\]:.*confirmed cup_1 \(cup\):", anchoring.text, re.S), \
+            anchoring.text
         # The dead node stays in the graph until its participant lease (3 s) expires.
         assert ros_probe.wait_for(lambda: "/anchoring" not in ros_probe.node_names(), timeout=15.0)
         anchoring = start_anchoring(node_process, tmp_path / "state", namespace)
