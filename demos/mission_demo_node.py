@@ -25,10 +25,12 @@ import threading
 import time
 from collections import deque
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import cv2
+import numpy as np
 from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
@@ -37,9 +39,10 @@ from merlin2_sailor.errors import ConfigurationError, SailorError
 from merlin2_sailor.knowledge import ChangeEvent, Proposition
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
 from merlin2_sailor.knowledge.pddl_writer import domain_from_store, problem_from_store
+from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions.perception import camera_info_to_intrinsics, pose_from_message
-from merlin2_sailor.ros.conversions.sensors import image_to_array
+from merlin2_sailor.ros.conversions.sensors import depth_to_metres, image_to_array
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
@@ -63,6 +66,17 @@ from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray
 _STATE_NAMES = {0: "tentative", 1: "confirmed", 2: "missing", 3: "forgotten"}
 EXPLORE_ACTIONS = ("navigation", "explore")
 FETCH_ACTIONS = ("navigation", "approach_object", "find_object")
+
+
+@dataclass(frozen=True)
+class _FrameToDraw:
+    """A colour frame due for the report, with what to draw on it, waiting for its depth image."""
+
+    stamp: float
+    colour: Image
+    pose: Pose
+    anchors: list[AnchorInView]
+    caption: str
 
 
 def _stamp(message: Any) -> float:
@@ -108,6 +122,8 @@ class MissionDemoNode(Node):
         self._path: list[tuple[float, float]] = []
         self._poses: deque[tuple[float, Any]] = deque(maxlen=60)
         self._detections: deque[tuple[float, list]] = deque(maxlen=60)
+        self._depths: deque[tuple[float, Image]] = deque(maxlen=5)  # converted only when a frame is drawn
+        self._pending_frame: _FrameToDraw | None = None
         self._intrinsics = None
         self._last_frame_time = 0.0
         self._frames = 0
@@ -120,6 +136,7 @@ class MissionDemoNode(Node):
         self.create_subscription(PoseStamped, "/camera/camera_pose", self._on_camera_pose, SENSOR_DATA)
         self.create_subscription(CameraInfo, "/camera/color/camera_info", self._on_camera_info, SENSOR_DATA)
         self.create_subscription(Image, "/camera/color/image_raw", self._on_image, SENSOR_DATA)
+        self.create_subscription(Image, "/camera/depth/image_raw", self._on_depth, SENSOR_DATA)
         self.create_timer(1.0, self._record_identities)
         self._log_handler = ForwardToRosLogger(self, say=self._say)
         self._log_handler.attach()
@@ -287,6 +304,22 @@ class MissionDemoNode(Node):
         if self._intrinsics is None:
             self._intrinsics = camera_info_to_intrinsics(message)
 
+    def _on_depth(self, message: Image) -> None:
+        stamp = _stamp(message)
+        self._depths.append((stamp, message))
+        if self._pending_frame is not None and abs(self._pending_frame.stamp - stamp) < 0.005:
+            self._draw(self._pending_frame, self._depth_at(stamp))
+
+    def _depth_at(self, stamp: float) -> np.ndarray | None:
+        """The depth image of the colour frame at ``stamp`` in metres; None if not here or bad."""
+        message = next((m for t, m in reversed(self._depths) if abs(t - stamp) < 0.005), None)
+        if message is None:
+            return None
+        try:
+            return depth_to_metres(image_to_array(message), message.encoding)
+        except SailorError:
+            return None
+
     def _on_image(self, message: Image) -> None:
         now = time.monotonic()
         if now - self._last_frame_time < self._frame_period or self._intrinsics is None:
@@ -299,16 +332,28 @@ class MissionDemoNode(Node):
         with self._lock:
             views = [AnchorInView(r.symbol, r.state, r.position, size, abs(seen - stamp) < 0.3)
                      for r, seen, size in self._anchor_views if r.state != "tentative"]
+        caption = f"t={now - self._started:5.1f} s  {self._account[-1][:80] if self._account else ''}"
+        if self._pending_frame is not None:  # its depth never came: drawn without the occlusion test
+            self._draw(self._pending_frame, None)
+        frame = _FrameToDraw(stamp, message, pose, views, caption)
+        depth = self._depth_at(stamp)
+        if depth is not None:
+            self._draw(frame, depth)
+        else:  # the depth of the same frame usually arrives just after the colour
+            self._pending_frame = frame
+
+    def _draw(self, frame: _FrameToDraw, depth: np.ndarray | None) -> None:
+        """Save the annotated frame; with depth, anchors behind walls are left out."""
+        self._pending_frame = None
         try:
-            rgb = image_to_array(message)
+            rgb = image_to_array(frame.colour)
         except SailorError:
             return
-        caption = f"t={now - self._started:5.1f} s  {self._account[-1][:80] if self._account else ''}"
-        frame = annotate_frame(rgb, self._intrinsics, pose, views, caption=caption)
+        drawn = annotate_frame(rgb, self._intrinsics, frame.pose, frame.anchors, caption=frame.caption, depth=depth)
         self._frames += 1
         path = self._folder / "frames" / f"frame_{self._frames:04d}.png"
         path.parent.mkdir(parents=True, exist_ok=True)
-        cv2.imwrite(str(path), cv2.cvtColor(frame, cv2.COLOR_RGB2BGR))
+        cv2.imwrite(str(path), cv2.cvtColor(drawn, cv2.COLOR_RGB2BGR))
 
     def destroy_node(self) -> None:
         self._session.cancel()

@@ -4,6 +4,11 @@ Anchors are projected into the frame through the camera pose at the frame's stam
 of each anchor's 3D box give its image box, so the picture shows where the anchoring layer
 believes each object is, not where the detector drew it. Detector boxes, when given, are drawn
 thin and grey underneath, so a gap between the two is visible at a glance.
+
+With the frame's depth image, an anchor hidden behind a wall is not drawn: a box drawn through
+the wall of the next room reads as an object the camera sees. Hidden means that nearly all of the
+box's pixels measure a surface clearly nearer than the anchor's nearest corner; a pixel without
+depth (beyond the sensor's range) hides nothing.
 """
 
 from __future__ import annotations
@@ -32,10 +37,19 @@ class AnchorInView:
     seen_now: bool
 
 
-def anchor_box(
-    anchor: AnchorInView, intrinsics: CameraIntrinsics, camera_to_world: Pose
-) -> tuple[int, int, int, int] | None:
+Box = tuple[int, int, int, int]
+OCCLUSION_MARGIN = 0.15  # m: depth noise plus a little; nearer than this in front of the anchor hides it
+HIDDEN_FRACTION = 0.9  # of the box's pixels: a door frame across part of an object does not hide it
+
+
+def anchor_box(anchor: AnchorInView, intrinsics: CameraIntrinsics, camera_to_world: Pose) -> Box | None:
     """The anchor's box in pixels (x0, y0, x1, y1), None when it is behind the camera or off-image."""
+    projected = _project(anchor, intrinsics, camera_to_world)
+    return projected[0] if projected is not None else None
+
+
+def _project(anchor: AnchorInView, intrinsics: CameraIntrinsics, camera_to_world: Pose) -> tuple[Box, float] | None:
+    """The anchor's box in pixels and the depth of its nearest corner."""
     half = np.asarray(anchor.size, dtype=float) / 2.0
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
     corners = np.asarray(anchor.position, dtype=float) + signs * half
@@ -48,7 +62,15 @@ def anchor_box(
     y0, y1 = max(y0, 0), min(y1, intrinsics.height - 1)
     if x1 <= x0 or y1 <= y0:
         return None
-    return int(x0), int(y0), int(x1), int(y1)
+    return (int(x0), int(y0), int(x1), int(y1)), float(depth.min())
+
+
+def hidden_by_nearer_surface(box: Box, nearest_depth: float, depth: np.ndarray) -> bool:
+    """Whether nearly all of the box shows a surface clearly in front of the anchor."""
+    x0, y0, x1, y1 = box
+    region = np.asarray(depth, dtype=np.float64)[y0 : y1 + 1, x0 : x1 + 1]
+    in_front = np.isfinite(region) & (region > 0.0) & (region < nearest_depth - OCCLUSION_MARGIN)
+    return bool(in_front.mean() >= HIDDEN_FRACTION)
 
 
 def annotate_frame(
@@ -58,14 +80,21 @@ def annotate_frame(
     anchors: Sequence[AnchorInView],
     detector_boxes: Sequence[tuple[float, float, float, float]] = (),
     caption: str = "",
+    depth: np.ndarray | None = None,
 ) -> np.ndarray:
-    """A copy of the RGB frame with detector boxes, anchor boxes and symbols, and a caption."""
+    """A copy of the RGB frame with detector boxes, anchor boxes and symbols, and a caption.
+
+    ``depth`` (metres, NaN or 0 where unknown, registered to ``rgb``) hides anchors behind walls.
+    """
     image = np.ascontiguousarray(rgb.copy())
     for x0, y0, x1, y1 in detector_boxes:
         cv2.rectangle(image, (int(x0), int(y0)), (int(x1), int(y1)), (170, 170, 170), 1)
     for anchor in anchors:
-        box = anchor_box(anchor, intrinsics, camera_to_world)
-        if box is None:
+        projected = _project(anchor, intrinsics, camera_to_world)
+        if projected is None:
+            continue
+        box, nearest_depth = projected
+        if depth is not None and hidden_by_nearer_surface(box, nearest_depth, depth):
             continue
         colour = _STATE_COLOURS.get(anchor.state, (0, 0, 0))
         x0, y0, x1, y1 = box

@@ -106,3 +106,30 @@ def test_anchors_are_projected_into_the_frame_where_they_are():
     assert frame.max() == 0  # the input is left alone
     assert np.all(drawn[y0, x0 + 5 : x1 - 5] == (30, 90, 200))  # the anchor's box edge, confirmed colour
     assert drawn[460:478, 0:80].max() == 255  # the caption
+
+
+def test_an_anchor_behind_a_wall_is_not_drawn_and_one_in_view_is():
+    from merlin2_sailor.perception.camera_model import CameraIntrinsics
+    from merlin2_sailor.perception.pose import Pose
+    from merlin2_sailor_demos.report.annotated_frame import AnchorInView, anchor_box, annotate_frame
+
+    intrinsics = CameraIntrinsics(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)
+    camera = Pose(np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]), np.array([0.0, 0.0, 1.0]))
+    cup = AnchorInView("cup_1", "confirmed", (2.0, 0.0, 1.0), (0.2, 0.2, 0.2), seen_now=False)
+    x0, y0, x1, y1 = anchor_box(cup, intrinsics, camera)
+    frame = np.zeros((480, 640, 3), dtype=np.uint8)
+
+    def drawn_with(depth: np.ndarray) -> bool:
+        image = annotate_frame(frame, intrinsics, camera, [cup], depth=depth)
+        return bool(np.all(image[y0, x0 + 5 : x1 - 5] == (30, 90, 200)))
+
+    wall = np.full((480, 640), 1.0, dtype=np.float32)  # a wall 1 m ahead, the cup 2 m ahead
+    assert not drawn_with(wall)
+    cup_surface = np.full((480, 640), 1.9, dtype=np.float32)  # the camera sees the cup itself
+    assert drawn_with(cup_surface)
+    assert drawn_with(np.full((480, 640), np.nan, dtype=np.float32))  # no depth proves nothing
+    door_frame = cup_surface.copy()
+    door_frame[:, : (x0 + x1) // 2] = 1.0  # half the cup behind a door frame: still in view
+    assert drawn_with(door_frame)
+    without_depth = annotate_frame(frame, intrinsics, camera, [cup])
+    assert np.all(without_depth[y0, x0 + 5 : x1 - 5] == (30, 90, 200))  # no depth given: drawn as before
