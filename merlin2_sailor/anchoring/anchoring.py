@@ -274,9 +274,10 @@ class Anchoring:
         A search for a MISSING anchor first looks at what was anchored while it was missing: an
         object moved while the robot was elsewhere and seen again from afar got a new anchor,
         because nothing said it was the lost one. If exactly one anchor of its class, first seen
-        after it went missing, lies in the searched disc, the search has found it: that anchor is
-        merged into the sought one, which keeps its symbol (see :meth:`_merge_into`). The result
-        holds the events of such a merge (none otherwise).
+        after it went missing and confirmed since (it may be missing again by now), lies in the
+        searched disc, the search has found it: that anchor is merged into the sought one, which
+        keeps its symbol (see :meth:`_merge_into`). The result holds the events of such a merge
+        (none otherwise).
         """
         anchor = self._require(symbol)
         when = self._latest_stamp if stamp is None else stamp
@@ -444,8 +445,8 @@ class Anchoring:
     # --- internals: top-down search ----------------------------------------------------------
 
     def _found_by_search(self, sought: Anchor, search: Expectation) -> Anchor | None:
-        """The one anchor a search for ``sought`` explains: confirmed, same class, born after it
-        went missing, inside the searched disc, and (when both have galleries) looking alike."""
+        """The one anchor a search for ``sought`` explains: not tentative, same class, born after
+        it went missing, inside the searched disc, and (when both have galleries) looking alike."""
         since = sought.missing_since if sought.missing_since is not None else sought.last_seen
         reach = search.radius + self.config.expectation_tolerance
         candidates = [
@@ -454,7 +455,9 @@ class Anchoring:
             if anchor is not sought
             and anchor.class_name == sought.class_name
             and anchor.first_seen >= since
-            and anchor.state is AnchorState.CONFIRMED  # a tentative one is too often a false detection
+            # Confirmed, or confirmed once and missing since (its place not in view, the object
+            # missed a few frames); a tentative one is too often a false detection.
+            and anchor.state in (AnchorState.CONFIRMED, AnchorState.MISSING)
             and anchor.expectation is None
             and float(np.linalg.norm(anchor.position[:2] - search.position[:2])) <= reach
             and self._look_alike(sought, anchor)
@@ -468,25 +471,32 @@ class Anchoring:
         return gallery_similarity(first.gallery, second.gallery) >= self.config.merge_similarity
 
     def _merge_into(self, kept: Anchor, merged: Anchor, changes: _Changes) -> None:
-        """``merged`` was ``kept`` all along: ``kept`` takes its observations, ``merged`` goes."""
+        """``merged`` was ``kept`` all along: ``kept`` takes its observations and state, ``merged``
+        goes. A ``merged`` that is missing leaves ``kept`` missing, on ``merged``'s clock: the
+        object was last seen under that symbol, and seeing it again confirms it as usual."""
+        still_missing = merged.state is AnchorState.MISSING
         self._remove(merged)
-        merged.state = AnchorState.FORGOTTEN
         kept.absorb_anchor(merged, self.config.fusion)
         kept.expectation = None
         kept.expectation_confirmed = False
         self._expected.discard(kept.symbol)
-        self._missing.discard(kept.symbol)
-        kept.state = AnchorState.CONFIRMED
-        kept.missing_since = None
-        kept.missed_frames = 0
-        kept.recovery_sightings = 0
+        kept.state = AnchorState.MISSING if still_missing else AnchorState.CONFIRMED
+        kept.missing_since = merged.missing_since if still_missing else None
+        kept.missed_frames = merged.missed_frames if still_missing else 0
+        kept.recovery_sightings = merged.recovery_sightings if still_missing else 0
+        merged.state = AnchorState.FORGOTTEN
+        if still_missing:
+            self._missing.add(kept.symbol)
+        else:
+            self._missing.discard(kept.symbol)
         self._index.refresh(kept)
         if kept.visible:
             self._visible.add(kept.symbol)
         changes.forgotten.append(merged)
         changes.reacquired.append(kept)
         changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"found to be {kept.symbol} by a search")
-        changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason="found by search", merged=merged.symbol)
+        if not still_missing:
+            changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason="found by search", merged=merged.symbol)
 
     # --- internals: lifecycle ---------------------------------------------------------------
 

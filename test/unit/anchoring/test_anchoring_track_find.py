@@ -342,6 +342,36 @@ def test_a_search_finds_the_object_anchored_anew_while_it_was_missing(make_ancho
     assert later.percept_symbols == ("cup_1",)
 
 
+def test_a_search_finds_the_newcomer_even_once_it_has_gone_missing_again(make_anchoring, maker, kitchen):
+    """Seen from a doorway and anchored anew, then missed for a few frames before the search came
+    there: still the sought object. The first symbol takes its place and stays missing until the
+    mug is seen again, which brings it back under that symbol."""
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    seen_twice(anchoring, maker, [cup])
+    lose(anchoring, 1.0)
+    elsewhere = np.array(cup.position) + (0.0, 4.0, 0.0)
+    towards = camera_view(yaw=math.atan2(elsewhere[1], elsewhere[0]))
+    for frame in range(2):
+        anchoring.process([maker.percept(cup, 2.0 + frame * FRAME, position=elsewhere)], towards, 2.0 + frame * FRAME)
+    frame = 0
+    while anchoring.get("cup_2").state is not AnchorState.MISSING and frame < 10:
+        anchoring.process([], towards, 2.5 + frame * FRAME)  # the detector misses it
+        frame += 1
+    assert anchoring.get("cup_2").state is AnchorState.MISSING
+    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 3.0, "bedroom", "find", radius=2.5))
+    assert {a.symbol for a in anchoring.anchors} == {"cup_1"}
+    assert [(e.kind, e.symbol) for e in result.events] == [(AnchorEventKind.FORGOTTEN, "cup_2")]
+    kept = anchoring.get("cup_1")
+    assert kept.state is AnchorState.MISSING and kept.expectation is None
+    np.testing.assert_allclose(kept.position, elsewhere, atol=0.05)
+    for frame in range(4):
+        stamp = 3.5 + frame * FRAME
+        later = anchoring.process([maker.percept(cup, stamp, position=elsewhere)], towards, stamp)
+        assert later.percept_symbols == ("cup_1",)
+    assert anchoring.get("cup_1").state is AnchorState.CONFIRMED
+
+
 def test_a_search_merges_nothing_when_the_newcomer_is_ambiguous_or_older(make_anchoring, maker, twin_mugs):
     anchoring = make_anchoring()
     mug_a, mug_b = twin_mugs.values()
