@@ -83,6 +83,16 @@ def _stamp(message: Any) -> float:
     return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
 
 
+_SAME_FRAME = 0.005  # s: colour and depth of one camera frame carry the same stamp
+
+
+def _depth_in_metres(message: Image) -> np.ndarray | None:
+    try:
+        return depth_to_metres(image_to_array(message), message.encoding)
+    except SailorError:
+        return None
+
+
 class MissionDemoNode(Node):
     """Runs the demo on a worker thread; sets ``exit_code`` when the report is written."""
 
@@ -307,18 +317,13 @@ class MissionDemoNode(Node):
     def _on_depth(self, message: Image) -> None:
         stamp = _stamp(message)
         self._depths.append((stamp, message))
-        if self._pending_frame is not None and abs(self._pending_frame.stamp - stamp) < 0.005:
-            self._draw(self._pending_frame, self._depth_at(stamp))
+        if self._pending_frame is not None and abs(self._pending_frame.stamp - stamp) < _SAME_FRAME:
+            self._draw(self._pending_frame, _depth_in_metres(message))
 
     def _depth_at(self, stamp: float) -> np.ndarray | None:
         """The depth image of the colour frame at ``stamp`` in metres; None if not here or bad."""
-        message = next((m for t, m in reversed(self._depths) if abs(t - stamp) < 0.005), None)
-        if message is None:
-            return None
-        try:
-            return depth_to_metres(image_to_array(message), message.encoding)
-        except SailorError:
-            return None
+        message = next((m for t, m in reversed(self._depths) if abs(t - stamp) < _SAME_FRAME), None)
+        return _depth_in_metres(message) if message is not None else None
 
     def _on_image(self, message: Image) -> None:
         now = time.monotonic()

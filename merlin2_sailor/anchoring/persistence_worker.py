@@ -72,6 +72,12 @@ class PersistenceWorker:
     def owned_objects(self) -> frozenset[str]:
         return self._owned
 
+    @property
+    def _claimed(self) -> frozenset[str]:
+        """What a restarted or rebuilt sync is given as its own: the owned objects and the
+        unconfirmed ones (it adopts only those the store holds)."""
+        return self._owned | self._unconfirmed
+
     def start(self) -> None:
         self._thread.start()
 
@@ -97,9 +103,9 @@ class PersistenceWorker:
         while the restarted node anchored the same things again under new symbols.
         """
         anchors = self._copy_anchors()
-        owned_before = self._owned | self._unconfirmed
+        claimed_before = self._claimed
         self._sync_knowledge_base(anchors.views)
-        created = not self._owned | self._unconfirmed <= owned_before
+        created = not self._claimed <= claimed_before
         if force_save or created or time.monotonic() >= self._next_save:
             self._save(anchors)
 
@@ -108,8 +114,7 @@ class PersistenceWorker:
             return
         self._next_save = time.monotonic() + self._save_period
         try:
-            # The unconfirmed too: a node restarted from this file adopts those the store holds.
-            self._state_file.save_anchors(anchors.snapshot(), self._owned | self._unconfirmed)
+            self._state_file.save_anchors(anchors.snapshot(), self._claimed)
         except OSError as error:
             self._log("error", f"cannot save anchors to {self._state_file.folder}: {error}")
 
@@ -131,8 +136,7 @@ class PersistenceWorker:
             if self._store is None:
                 self._store = self._open_knowledge_base()
             if self._sync is None:
-                self._sync = KnowledgeSync(self._store, self._grounding,
-                                           owned=self._owned | self._unconfirmed)
+                self._sync = KnowledgeSync(self._store, self._grounding, owned=self._claimed)
             self._sync.sync(views)
             self._owned = self._sync.owned_objects
             self._unconfirmed = frozenset()

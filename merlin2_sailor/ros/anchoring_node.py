@@ -334,11 +334,14 @@ class AnchoringNode(Node):
     def _publish(self, result: AnchoringResult) -> None:
         if not result.events:
             return
+        # The anchors the events name, looked up one by one: walking every anchor per frame
+        # would cost as much as the frame itself with thousands of anchors.
         with self._lock:
-            class_names = {anchor.symbol: anchor.class_name for anchor in self._anchoring.anchors}
-            tentative = {anchor.symbol for anchor in self._anchoring.anchors
-                         if anchor.state is AnchorState.TENTATIVE}
-        class_names.update({anchor.symbol: anchor.class_name for anchor in result.forgotten})
+            named = {event.symbol: self._anchoring.get(event.symbol) for event in result.events}
+        named.update({anchor.symbol: anchor for anchor in result.forgotten})
+        class_names = {symbol: anchor.class_name for symbol, anchor in named.items() if anchor is not None}
+        tentative = {symbol for symbol, anchor in named.items()
+                     if anchor is not None and anchor.state is AnchorState.TENTATIVE}
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
         self._events_publisher.publish(events_to_message(result.events, class_names, header))
         for event in result.events:  # a running account; reacquisitions would flood it
