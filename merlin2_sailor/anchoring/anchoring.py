@@ -8,7 +8,9 @@ One frame (:meth:`Anchoring.process`) follows the paper's algorithm, then the li
    percept), every other percept acquires a new anchor with a fresh symbol;
 3. an anchor not reacquired is checked against the camera: only if it should have been visible
    (in the frustum, not occluded by nearer depth) does it count towards MISSING; an anchor with
-   an expected location seen empty has that expectation RETRACTED instead.
+   an expected location seen empty has that expectation RETRACTED instead;
+4. a newcomer confirmed where a MISSING anchor of its class was lost is that object reappearing,
+   and is merged into it (see :meth:`Anchoring._merge_reappearances`).
 
 :meth:`Anchoring.track` moves anchors without observation (static objects stay put; carried ones
 follow the robot) and applies time-outs; :meth:`Anchoring.expect` records an action's expected
@@ -59,13 +61,17 @@ class AnchoringConfig:
     ``expectation_tolerance`` (m): how close to an expected place a reacquired object must be
     to confirm the expectation (farther retracts it);
     ``merge_similarity``: the cosine similarity of appearance galleries below which a search
-    never takes an anchor born while the sought one was missing as the sought one.
+    never takes an anchor born while the sought one was missing as the sought one, and a
+    newcomer is never taken for a missing anchor reappearing;
+    ``reappearance_distance`` (m): how close to a MISSING anchor a newcomer of its class must be
+    confirmed to be taken for it (below the 0.3 m between books on a shelf).
     """
 
     match_threshold: float = 0.5
     world_frame: str = "map"
     expectation_tolerance: float = 1.0
     merge_similarity: float = 0.8
+    reappearance_distance: float = 0.25
     table: MatchingTableConfig = field(default_factory=MatchingTableConfig)
     fusion: FusionConfig = field(default_factory=FusionConfig)
     partial_view: PartialViewConfig = field(default_factory=PartialViewConfig)
@@ -82,6 +88,11 @@ class AnchoringConfig:
             raise ConfigurationError(
                 "anchoring expectation_tolerance must be a positive number of metres, "
                 f"got {self.expectation_tolerance}."
+            )
+        if not (math.isfinite(self.reappearance_distance) and self.reappearance_distance >= 0.0):
+            raise ConfigurationError(
+                "anchoring reappearance_distance must be a non-negative number of metres (0 turns the merge off), "
+                f"got {self.reappearance_distance}."
             )
 
 
@@ -108,6 +119,8 @@ class _Changes:
     missing: list[Anchor] = field(default_factory=list)
     forgotten: list[Anchor] = field(default_factory=list)
     events: list[AnchorEvent] = field(default_factory=list)
+    confirmed_newcomers: list[Anchor] = field(default_factory=list)
+    """Anchors confirmed for the first time in this call: not part of the result."""
 
     def event(self, kind: AnchorEventKind, symbol: str, **details: Any) -> None:
         self.events.append(AnchorEvent(kind, symbol, self.stamp, details))
@@ -236,6 +249,10 @@ class Anchoring:
 
         if camera is not None:
             self._check_unseen(camera, seen, changes)
+        renamed = self._merge_reappearances(changes)
+        if renamed:
+            symbols = [renamed.get(symbol, symbol) for symbol in symbols]
+            seen = {renamed.get(symbol, symbol) for symbol in seen}
         for symbol in self._visible - seen:
             anchor = self._index.get(symbol)
             if anchor is not None:
@@ -380,6 +397,7 @@ class Anchoring:
                       at=_position_text(anchor.position))
         if became_confirmed:
             changes.event(AnchorEventKind.CONFIRMED, symbol, reason="seen", times_seen=anchor.times_seen)
+            changes.confirmed_newcomers.append(anchor)
         return anchor
 
     def _reacquire(
@@ -416,6 +434,8 @@ class Anchoring:
         )
         if became_confirmed:
             changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="seen", times_seen=anchor.times_seen)
+            if not was_missing:
+                changes.confirmed_newcomers.append(anchor)
 
     def _resolve_expectation(self, anchor: Anchor, percept: Percept, changes: _Changes) -> None:
         """Perception outranks expectation: seen near the expected place confirms, elsewhere retracts."""
@@ -470,13 +490,75 @@ class Anchoring:
             return True
         return gallery_similarity(first.gallery, second.gallery) >= self.config.merge_similarity
 
-    def _merge_into(self, kept: Anchor, merged: Anchor, changes: _Changes) -> None:
+    # --- internals: a missing object reappearing --------------------------------------------
+
+    def _merge_reappearances(self, changes: _Changes) -> dict[str, str]:
+        """Merge newcomers that are missing anchors seen again; return {newcomer: kept symbol}.
+
+        Two percepts of one class can compete for one anchor in a frame (a false detection whose
+        large box forgives its distance, next to the real object); the real one then becomes a
+        new anchor, which wins every later frame while the old one, unseen, goes MISSING: a
+        duplicate the knowledge base would keep. The newcomer is that object if it was confirmed
+        within ``reappearance_distance`` of a MISSING anchor of its class that has not been seen
+        since the newcomer was born, and each is the only candidate of the other. Checked when a
+        newcomer is confirmed and when an anchor goes missing, whichever comes last.
+        """
+        if self.config.reappearance_distance <= 0.0:
+            return {}
+        lost_candidates = {anchor.symbol: anchor for anchor in changes.missing}
+        for newcomer in changes.confirmed_newcomers:
+            for anchor in self._near(newcomer.position):
+                if anchor.state is AnchorState.MISSING:
+                    lost_candidates.setdefault(anchor.symbol, anchor)
+        renamed: dict[str, str] = {}
+        for symbol in sorted(lost_candidates):
+            lost = self._index.get(symbol)
+            found = None if lost is None else self._reappeared_as(lost)
+            if lost is not None and found is not None:
+                self._merge_into(lost, found, changes, reason="reappeared where it went missing")
+                renamed[found.symbol] = lost.symbol
+        return renamed
+
+    def _reappeared_as(self, lost: Anchor) -> Anchor | None:
+        """The one confirmed newcomer that is ``lost`` seen again, if exactly one is."""
+        if lost.state is not AnchorState.MISSING or lost.expectation is not None:
+            return None
+        candidates = [
+            anchor for anchor in self._near(lost.position)
+            if self._may_be_reappearance(lost, anchor) and anchor.state is AnchorState.CONFIRMED
+        ]
+        if len(candidates) != 1:
+            return None
+        newcomer = candidates[0]
+        rivals = [
+            anchor for anchor in self._near(newcomer.position)
+            if anchor.state is AnchorState.MISSING and anchor.expectation is None
+            and self._may_be_reappearance(anchor, newcomer)
+        ]
+        return newcomer if rivals == [lost] else None
+
+    def _may_be_reappearance(self, lost: Anchor, newcomer: Anchor) -> bool:
+        """Same class, born no earlier than ``lost`` was last seen (so never seen apart from it
+        in two frames), nothing expected of it, and not ruled out by appearance."""
+        return (
+            newcomer is not lost
+            and newcomer.class_name == lost.class_name
+            and newcomer.first_seen >= lost.last_seen
+            and newcomer.expectation is None
+            and self._look_alike(lost, newcomer)
+        )
+
+    def _near(self, position: np.ndarray) -> list[Anchor]:
+        slots = self._index.within(position.reshape(1, 3), self.config.reappearance_distance)[0]
+        return self._index.anchors_at(slots)
+
+    def _merge_into(self, kept: Anchor, merged: Anchor, changes: _Changes, reason: str = "found by search") -> None:
         """``merged`` was ``kept`` all along: ``kept`` takes its observations and state, ``merged``
         goes. A ``merged`` that is missing leaves ``kept`` missing, on ``merged``'s clock: the
         object was last seen under that symbol, and seeing it again confirms it as usual."""
         still_missing = merged.state is AnchorState.MISSING
-        self._remove(merged)
         kept.absorb_anchor(merged, self.config.fusion)
+        self._remove(merged)
         kept.expectation = None
         kept.expectation_confirmed = False
         self._expected.discard(kept.symbol)
@@ -494,9 +576,9 @@ class Anchoring:
             self._visible.add(kept.symbol)
         changes.forgotten.append(merged)
         changes.reacquired.append(kept)
-        changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"found to be {kept.symbol} by a search")
+        changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"{reason}: it is {kept.symbol}")
         if not still_missing:
-            changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason="found by search", merged=merged.symbol)
+            changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=reason, merged=merged.symbol)
 
     # --- internals: lifecycle ---------------------------------------------------------------
 

@@ -1,0 +1,128 @@
+"""A missing object seen again under a new symbol is merged back into its first anchor.
+
+The case comes from a mission run: a book on a desk, seen from a doorway, went missing while
+the robot drove out of depth range; when it came back in range, a false detection with a large
+box (which forgives its distance, see ``features.extent_slack``) took the missing anchor in the
+same frame as the real book, so the book got a new anchor and the knowledge base kept the old
+one as ``missing`` for good.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, LifecycleConfig
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
+from merlin2_sailor.errors import ConfigurationError
+
+from .anchoring_scenes import SceneObject, camera_view
+
+FRAME = 1.0 / 15.0
+BOOK = SceneObject("desk_book", "book", (3.0, 0.2, 0.9), (0.05, 0.2, 0.26))
+#: A false detection's box over the desk and the wall: a metre wide, centred a little off the book.
+FALSE_BOOK = SceneObject("false_book", "book", (3.1, 0.0, 0.9), (0.9, 0.9, 0.9))
+
+
+def see(anchoring, percepts, stamp):
+    return anchoring.process(percepts, camera_view(), stamp)
+
+
+def books(anchoring):
+    return sorted((anchor.symbol, anchor.state) for anchor in anchoring.anchors)
+
+
+def test_a_newcomer_confirmed_where_an_anchor_went_missing_is_that_anchor(make_anchoring, maker):
+    anchoring = make_anchoring()  # confirmed after 2 sightings, missing after 1 missed frame
+    for frame in range(2):
+        see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
+    see(anchoring, [], 1.0)  # out of depth range: the detection is dropped
+    assert books(anchoring) == [("book_1", AnchorState.MISSING)]
+
+    # Back in range 3 s later: the false detection takes the missing anchor, the book a new one.
+    first = see(anchoring, [maker.percept(BOOK, 4.0), maker.percept(FALSE_BOOK, 4.0)], 4.0)
+    assert first.percept_symbols == ("book_2", "book_1")
+
+    second = see(anchoring, [maker.percept(BOOK, 4.0 + FRAME)], 4.0 + FRAME)
+    assert books(anchoring) == [("book_1", AnchorState.CONFIRMED)]
+    assert second.percept_symbols == ("book_1",)
+    assert [(event.kind, event.symbol, event.details.get("reason")) for event in second.events][-2:] == [
+        (AnchorEventKind.FORGOTTEN, "book_2", "reappeared where it went missing: it is book_1"),
+        (AnchorEventKind.CONFIRMED, "book_1", "reappeared where it went missing"),
+    ]
+    kept = anchoring.get("book_1")
+    np.testing.assert_allclose(kept.position, BOOK.position, atol=0.05)
+    assert kept.missing_since is None and kept.visible
+    assert see(anchoring, [maker.percept(BOOK, 5.0)], 5.0).percept_symbols == ("book_1",)
+
+
+def test_the_anchor_going_missing_after_its_newcomer_was_confirmed_is_merged_too(maker):
+    """With the default lifecycle the newcomer is confirmed (3 sightings) before the anchor whose
+    percept it took is missing (3 missed frames): the merge happens when the second of the two
+    comes true."""
+    anchoring = Anchoring(AnchoringConfig())
+    for frame in range(3):
+        see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
+    stamp = 20.0
+    see(anchoring, [maker.percept(BOOK, stamp), maker.percept(FALSE_BOOK, stamp)], stamp)
+    assert {anchor.symbol for anchor in anchoring.anchors} == {"book_1", "book_2"}
+    merged_at = None
+    for frame in range(1, 5):
+        stamp = 20.0 + frame * FRAME
+        result = see(anchoring, [maker.percept(BOOK, stamp)], stamp)
+        if any(event.kind is AnchorEventKind.FORGOTTEN for event in result.events):
+            merged_at = frame
+            break
+    assert merged_at == 3  # book_2 confirmed at frame 2, book_1 missing at frame 3
+    assert books(anchoring) == [("book_1", AnchorState.CONFIRMED)]
+    assert result.percept_symbols == ("book_1",)
+
+
+def test_two_objects_seen_apart_are_never_merged(make_anchoring, maker):
+    """Two books side by side, both seen in the same frames: when one goes missing, the other is
+    not it, however near (it was seen while the lost one still was)."""
+    anchoring = make_anchoring()
+    neighbour = SceneObject("neighbour", "book", (3.0, 0.4, 0.9), (0.05, 0.2, 0.26))
+    for frame in range(3):
+        see(anchoring, [maker.percept(BOOK, frame * FRAME), maker.percept(neighbour, frame * FRAME)], frame * FRAME)
+    see(anchoring, [maker.percept(neighbour, 1.0)], 1.0)
+    assert books(anchoring) == [("book_1", AnchorState.MISSING), ("book_2", AnchorState.CONFIRMED)]
+
+
+@pytest.mark.parametrize(("offset", "merged"), [(0.2, True), (0.35, False)])
+def test_only_a_newcomer_within_the_reappearance_distance_is_merged(maker, offset, merged):
+    """A strict matcher (0.1 m) refuses the percept, so the book is anchored anew beside its
+    missing anchor: 0.2 m away it is taken for it, 0.35 m away (farther than the 0.25 m
+    reappearance distance) it is not. A cup seen at the book's very place never is."""
+    anchoring = Anchoring(
+        AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=2, missed_frames_to_missing=1)),
+        RuleMatcher(RuleMatcherConfig(position_sigma=0.1, drift_speed=0.0, maximum_sigma=0.1)),
+    )
+    for frame in range(2):
+        see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
+    see(anchoring, [], 1.0)
+    beside = np.array(BOOK.position) + (0.0, offset, 0.0)
+    cup = SceneObject("cup", "cup", BOOK.position)
+    for frame in range(3):
+        stamp = 2.0 + frame * FRAME
+        see(anchoring, [maker.percept(BOOK, stamp, position=beside), maker.percept(cup, stamp)], stamp)
+    states = {anchor.symbol: anchor.state for anchor in anchoring.anchors}
+    if merged:
+        assert states == {"book_1": AnchorState.CONFIRMED, "cup_1": AnchorState.CONFIRMED}
+    else:
+        assert states == {"book_1": AnchorState.MISSING, "book_2": AnchorState.CONFIRMED,
+                          "cup_1": AnchorState.CONFIRMED}
+
+
+def test_the_reappearance_merge_can_be_turned_off_and_is_validated(maker):
+    anchoring = Anchoring(AnchoringConfig(
+        reappearance_distance=0.0,
+        lifecycle=LifecycleConfig(confirm_after=2, missed_frames_to_missing=1)))
+    for frame in range(2):
+        see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
+    see(anchoring, [], 1.0)
+    see(anchoring, [maker.percept(BOOK, 4.0), maker.percept(FALSE_BOOK, 4.0)], 4.0)
+    see(anchoring, [maker.percept(BOOK, 4.0 + FRAME)], 4.0 + FRAME)
+    assert len(anchoring) == 2
+    with pytest.raises(ConfigurationError, match="reappearance_distance"):
+        AnchoringConfig(reappearance_distance=float("nan"))
