@@ -138,17 +138,20 @@ class Anchor:
         self.missed_frames = 0
         self.missing_since = None
 
-    def absorb_anchor(self, other: Anchor, config: FusionConfig) -> None:
+    def absorb_anchor(self, other: Anchor, config: FusionConfig, moved: bool = True) -> None:
         """Merge: ``other`` turned out to be this object, seen again under a new symbol.
 
-        Its latest position is where the object is now (this anchor's older one is where it
-        was), its views join the gallery, and its sightings and class votes add to this one's.
+        Its views join the gallery, and its sightings and class votes add to this one's. Where
+        the object is: if it ``moved`` (found elsewhere by a search), where ``other`` saw it; if
+        it reappeared where it was, ``other``'s position too, unless ``other`` saw only part of it
+        and this anchor had a whole view, whose centre and size say more (as in :meth:`absorb`).
         """
-        self.position = other.position.copy()
-        self.position_variance = other.position_variance
-        self.perceived_position = other.perceived_position.copy()
-        self.size = other.size.copy()
-        self.whole_views = other.whole_views
+        if moved or other.whole_views > 0 or self.whole_views == 0:
+            self.position = other.position.copy()
+            self.position_variance = other.position_variance
+            self.perceived_position = other.perceived_position.copy()
+            self.size = other.size.copy()
+            self.whole_views = other.whole_views if moved else self.whole_views + other.whole_views
         for class_name, votes in other.class_votes.items():
             self.class_votes[class_name] = self.class_votes.get(class_name, 0.0) + votes
         self.class_name = winning_class(self.class_votes, self.class_name)

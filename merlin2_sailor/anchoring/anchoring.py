@@ -32,6 +32,7 @@ from merlin2_sailor.anchoring.anchor_index import AnchorIndex, IndexConfig
 from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation, ExpectationKind
+from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.gallery import gallery_similarity
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_expected_but_unseen, after_sighting, expire
@@ -496,18 +497,20 @@ class Anchoring:
         """Merge newcomers that are missing anchors seen again; return {newcomer: kept symbol}.
 
         Two percepts of one class can compete for one anchor in a frame (a false detection whose
-        large box forgives its distance, next to the real object); the real one then becomes a
-        new anchor, which wins every later frame while the old one, unseen, goes MISSING: a
-        duplicate the knowledge base would keep. The newcomer is that object if it was confirmed
-        within ``reappearance_distance`` of a MISSING anchor of its class that has not been seen
-        since the newcomer was born, and each is the only candidate of the other. Checked when a
-        newcomer is confirmed and when an anchor goes missing, whichever comes last.
+        large box forgives its distance, next to the real object; the near end of a bicycle next
+        to its whole); the real one then becomes a new anchor, which wins every later frame
+        while the old one, unseen, goes MISSING: a duplicate the knowledge base would keep. The
+        newcomer is that object if it was confirmed within ``reappearance_distance`` (beyond
+        what a large object's extent explains, as in matching) of a MISSING anchor of its class
+        that has not been seen since the newcomer was born, and each is the only candidate of
+        the other. Checked when a newcomer is confirmed and when an anchor goes missing,
+        whichever comes last.
         """
         if self.config.reappearance_distance <= 0.0:
             return {}
         lost_candidates = {anchor.symbol: anchor for anchor in changes.missing}
         for newcomer in changes.confirmed_newcomers:
-            for anchor in self._near(newcomer.position):
+            for anchor in self._within_reappearance_distance(newcomer):
                 if anchor.state is AnchorState.MISSING:
                     lost_candidates.setdefault(anchor.symbol, anchor)
         renamed: dict[str, str] = {}
@@ -515,7 +518,7 @@ class Anchoring:
             lost = self._index.get(symbol)
             found = None if lost is None else self._reappeared_as(lost)
             if lost is not None and found is not None:
-                self._merge_into(lost, found, changes, reason="reappeared where it went missing")
+                self._merge_into(lost, found, changes, reason="reappeared where it went missing", moved=False)
                 renamed[found.symbol] = lost.symbol
         return renamed
 
@@ -524,14 +527,14 @@ class Anchoring:
         if lost.state is not AnchorState.MISSING or lost.expectation is not None:
             return None
         candidates = [
-            anchor for anchor in self._near(lost.position)
-            if self._may_be_reappearance(lost, anchor) and anchor.state is AnchorState.CONFIRMED
+            anchor for anchor in self._within_reappearance_distance(lost)
+            if anchor.state is AnchorState.CONFIRMED and self._may_be_reappearance(lost, anchor)
         ]
         if len(candidates) != 1:
             return None
         newcomer = candidates[0]
         rivals = [
-            anchor for anchor in self._near(newcomer.position)
+            anchor for anchor in self._within_reappearance_distance(newcomer)
             if anchor.state is AnchorState.MISSING and anchor.expectation is None
             and self._may_be_reappearance(anchor, newcomer)
         ]
@@ -548,16 +551,29 @@ class Anchoring:
             and self._look_alike(lost, newcomer)
         )
 
-    def _near(self, position: np.ndarray) -> list[Anchor]:
-        slots = self._index.within(position.reshape(1, 3), self.config.reappearance_distance)[0]
-        return self._index.anchors_at(slots)
+    def _within_reappearance_distance(self, anchor: Anchor) -> list[Anchor]:
+        """Other anchors whose centre lies within the reappearance distance of this one's, plus
+        what either's extent explains (views of a large object are not centred alike)."""
+        reach = self.config.reappearance_distance
+        own_slack = float(extent_slack(anchor.size))
+        radius = reach + max(own_slack, self._index.largest_extent_slack())
+        slots = self._index.within(anchor.position.reshape(1, 3), radius)[0]
+        nearby = []
+        for other in self._index.anchors_at(slots):
+            slack = max(own_slack, float(extent_slack(other.size)))
+            if other is not anchor and np.linalg.norm(other.position - anchor.position) - slack <= reach:
+                nearby.append(other)
+        return nearby
 
-    def _merge_into(self, kept: Anchor, merged: Anchor, changes: _Changes, reason: str = "found by search") -> None:
+    def _merge_into(
+        self, kept: Anchor, merged: Anchor, changes: _Changes, reason: str = "found by search", moved: bool = True
+    ) -> None:
         """``merged`` was ``kept`` all along: ``kept`` takes its observations and state, ``merged``
-        goes. A ``merged`` that is missing leaves ``kept`` missing, on ``merged``'s clock: the
-        object was last seen under that symbol, and seeing it again confirms it as usual."""
+        goes (``moved``: the object was found elsewhere, see :meth:`Anchor.absorb_anchor`). A
+        ``merged`` that is missing leaves ``kept`` missing, on ``merged``'s clock: the object was
+        last seen under that symbol, and seeing it again confirms it as usual."""
         still_missing = merged.state is AnchorState.MISSING
-        kept.absorb_anchor(merged, self.config.fusion)
+        kept.absorb_anchor(merged, self.config.fusion, moved)
         self._remove(merged)
         kept.expectation = None
         kept.expectation_confirmed = False

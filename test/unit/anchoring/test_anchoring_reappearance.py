@@ -9,10 +9,13 @@ one as ``missing`` for good.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, LifecycleConfig
+from merlin2_sailor.anchoring.percept import BoundingBox2D
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.errors import ConfigurationError
 
@@ -112,6 +115,30 @@ def test_only_a_newcomer_within_the_reappearance_distance_is_merged(maker, offse
     else:
         assert states == {"book_1": AnchorState.MISSING, "book_2": AnchorState.CONFIRMED,
                           "cup_1": AnchorState.CONFIRMED}
+
+
+def test_a_large_object_seen_again_in_part_is_merged_and_keeps_its_whole_view(maker):
+    """The near end of a bicycle, cut by the image's edge, is centred 0.8 m from the whole
+    bicycle's centre: its extent explains that, as in matching. The merged anchor keeps the
+    centre and size of its whole views; a part says less about them."""
+    anchoring = Anchoring(
+        AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=2, missed_frames_to_missing=1)),
+        RuleMatcher(RuleMatcherConfig(position_sigma=0.1, drift_speed=0.0, maximum_sigma=0.1)),
+    )
+    bicycle = SceneObject("bicycle", "bicycle", (3.0, 0.0, 0.5), (0.35, 1.6, 1.0))
+    near_end = SceneObject("bicycle_end", "bicycle", (3.0, -0.8, 0.5), (0.27, 0.08, 1.0))
+    for frame in range(2):
+        see(anchoring, [maker.percept(bicycle, frame * FRAME)], frame * FRAME)
+    see(anchoring, [], 1.0)
+    at_the_edge = BoundingBox2D(center_x=6.0, center_y=60.0, width=12.0, height=60.0)
+    for frame in range(2):
+        stamp = 2.0 + frame * FRAME
+        see(anchoring, [dataclasses.replace(maker.percept(near_end, stamp), box=at_the_edge)], stamp)
+    assert books(anchoring) == [("bicycle_1", AnchorState.CONFIRMED)]
+    kept = anchoring.get("bicycle_1")
+    np.testing.assert_allclose(kept.position, bicycle.position, atol=0.05)
+    np.testing.assert_allclose(kept.size, bicycle.size, rtol=0.1)
+    assert kept.times_seen == 4
 
 
 def test_the_reappearance_merge_can_be_turned_off_and_is_validated(maker):
