@@ -69,6 +69,9 @@ class Anchor:
     recovery_sightings: int = 0
     """Sightings since the anchor went missing; it is confirmed again after ``confirm_after``."""
     missing_since: float | None = None
+    lost_after: float | None = None
+    """While MISSING: its last sighting before it went missing (later sightings while missing,
+    too few to bring it back, do not count): an anchor born after it may be the object, moved."""
     provenance: Provenance = Provenance.PERCEIVED
     """PERCEIVED when ``position`` comes from the camera, EXPECTED when from an action's effect."""
     perceived_position: np.ndarray = field(default_factory=_zero_vector)

@@ -292,8 +292,9 @@ class Anchoring:
         A search for a MISSING anchor first looks at what was anchored while it was missing: an
         object moved while the robot was elsewhere and seen again from afar got a new anchor,
         because nothing said it was the lost one. If exactly one anchor of its class, first seen
-        after it went missing and confirmed since (it may be missing again by now), lies in the
-        searched disc, the search has found it: that anchor is merged into the sought one, which
+        after it went missing (or, if none was, after its last sighting before that) and
+        confirmed since (it may be missing again by now), lies in the searched disc, the search
+        has found it: that anchor is merged into the sought one, which
         keeps its symbol (see :meth:`_merge_into`). The result holds the events of such a merge
         (none otherwise).
         """
@@ -466,16 +467,24 @@ class Anchoring:
     # --- internals: top-down search ----------------------------------------------------------
 
     def _found_by_search(self, sought: Anchor, search: Expectation) -> Anchor | None:
-        """The one anchor a search for ``sought`` explains: not tentative, same class, born after
-        it went missing, inside the searched disc, and (when both have galleries) looking alike."""
-        since = sought.missing_since if sought.missing_since is not None else sought.last_seen
+        """The one anchor a search for ``sought`` explains: not tentative, same class, inside the
+        searched disc, (when both have galleries) looking alike, and born after it went missing;
+        failing that, born after its last sighting before it went missing (the object may have
+        been moved and seen anew before its old place was found empty)."""
+        since_missing = sought.missing_since if sought.missing_since is not None else sought.last_seen
+        candidates = self._search_candidates(sought, search, since_missing)
+        if not candidates and sought.lost_after is not None and sought.lost_after < since_missing:
+            candidates = self._search_candidates(sought, search, sought.lost_after)
+        return candidates[0] if len(candidates) == 1 else None
+
+    def _search_candidates(self, sought: Anchor, search: Expectation, born_since: float) -> list[Anchor]:
         reach = search.radius + self.config.expectation_tolerance
-        candidates = [
+        return [
             anchor
             for anchor in self._index
             if anchor is not sought
             and anchor.class_name == sought.class_name
-            and anchor.first_seen >= since
+            and anchor.first_seen >= born_since
             # Confirmed, or confirmed once and missing since (its place not in view, the object
             # missed a few frames); a tentative one is too often a false detection.
             and anchor.state in (AnchorState.CONFIRMED, AnchorState.MISSING)
@@ -483,7 +492,6 @@ class Anchoring:
             and float(np.linalg.norm(anchor.position[:2] - search.position[:2])) <= reach
             and self._look_alike(sought, anchor)
         ]
-        return candidates[0] if len(candidates) == 1 else None
 
     def _look_alike(self, first: Anchor, second: Anchor) -> bool:
         """Appearance does not rule the pair out (unknown appearance rules nothing out)."""
@@ -580,6 +588,7 @@ class Anchoring:
         self._expected.discard(kept.symbol)
         kept.state = AnchorState.MISSING if still_missing else AnchorState.CONFIRMED
         kept.missing_since = merged.missing_since if still_missing else None
+        kept.lost_after = merged.lost_after if still_missing else None
         kept.missed_frames = merged.missed_frames if still_missing else 0
         kept.recovery_sightings = merged.recovery_sightings if still_missing else 0
         merged.state = AnchorState.FORGOTTEN

@@ -65,6 +65,7 @@ def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
             return False
         anchor.recovery_sightings = 0
         anchor.state = AnchorState.CONFIRMED
+        anchor.lost_after = None
         return True
     if was_confirmed(anchor, config):
         became_confirmed = anchor.state is AnchorState.TENTATIVE
@@ -90,6 +91,7 @@ def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleCon
     if anchor.state is AnchorState.TENTATIVE:
         return False
     anchor.state = AnchorState.MISSING
+    anchor.lost_after = anchor.last_seen
     return True
 
 

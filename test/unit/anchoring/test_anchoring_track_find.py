@@ -190,6 +190,8 @@ def test_forget_removes_the_anchor_and_reports_it(make_anchoring, maker, kitchen
 def test_snapshot_restore_round_trip_survives_json(make_anchoring, maker, kitchen):
     anchoring = make_anchoring()
     seen_twice(anchoring, maker, KITCHEN)
+    anchoring.process([maker.percept(kitchen["red_cup"], 0.4), maker.percept(kitchen["blue_bowl"], 0.4)],
+                      camera_view(), 0.4)  # the apple goes missing
     anchoring.expect("bowl_1", Expectation.at((1.0, 1.0, 0.8), stamp=0.5, place="sink", source="place"))
     snapshot = json.loads(json.dumps(anchoring.snapshot()))
 
@@ -204,8 +206,10 @@ def test_snapshot_restore_round_trip_survives_json(make_anchoring, maker, kitche
         assert (copy.state, copy.times_seen, copy.class_votes, copy.last_seen, copy.provenance) == (
             original.state, original.times_seen, original.class_votes, original.last_seen, original.provenance
         )
+        assert (copy.missing_since, copy.lost_after) == (original.missing_since, original.lost_after)
         assert copy.visible is False
     assert restarted.get("bowl_1").expectation.place == "sink"
+    assert restarted.get("apple_1").lost_after == FRAME  # its last sighting before it went missing
     # the restored anchors are matched, and the default counter does not reissue their symbols
     another_cup = SceneObject("another_cup", "cup", (8.0, 8.0, 0.8))
     result = restarted.process([maker.percept(kitchen["red_cup"], 1.0), maker.percept(another_cup, 1.0)], None, 1.0)
@@ -380,3 +384,36 @@ def test_a_search_merges_nothing_when_the_newcomer_is_ambiguous_or_older(make_an
     (missing,) = [a.symbol for a in anchoring.anchors if a.state is AnchorState.MISSING]
     result = anchoring.expect(missing, Expectation.at(mug_b.position, 0.6, source="find", radius=2.0))
     assert result.events == () and len(anchoring) == 2  # the twin was known before: not a newcomer
+
+
+@pytest.mark.parametrize("seen_after_the_other_mug", [True, False])
+def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_empty(
+    make_anchoring, maker, kitchen, seen_after_the_other_mug
+):
+    """Moved, and seen at once in the living room beside another mug, before the robot found its
+    old place empty: the newcomer is older than the missing anchor's loss, but younger than its
+    last sighting. If the other mug was first seen after that sighting too, nothing tells the two
+    apart without appearance, and the search merges neither."""
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    other_mug = SceneObject("green_mug", "cup", (1.5, 5.5, 0.8))
+    seen_twice(anchoring, maker, [cup])
+    for frame in range(2):  # in another room, by a camera that does not see the kitchen
+        anchoring.process([maker.percept(other_mug, 0.5 + frame * FRAME)], None, 0.5 + frame * FRAME)
+    if seen_after_the_other_mug:
+        anchoring.process([maker.percept(cup, 1.0)], camera_view(), 1.0)
+    moved_to = np.array((1.5, 6.0, 0.8))
+    for frame in range(2):
+        anchoring.process([maker.percept(cup, 2.0 + frame * FRAME, position=moved_to)], None, 2.0 + frame * FRAME)
+    lose(anchoring, 3.0)
+    assert {a.symbol: a.state for a in anchoring.anchors} == {
+        "cup_1": AnchorState.MISSING, "cup_2": AnchorState.CONFIRMED, "cup_3": AnchorState.CONFIRMED}
+    result = anchoring.expect("cup_1", Expectation.at((1.5, 5.75, 0.8), 3.5, "living_room", "find", radius=1.0))
+    if seen_after_the_other_mug:
+        assert [(e.kind, e.symbol) for e in result.events] == [
+            (AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, "cup_1")]
+        assert {a.symbol for a in anchoring.anchors} == {"cup_1", "cup_2"}
+        np.testing.assert_allclose(anchoring.get("cup_1").position, moved_to, atol=0.05)
+        assert anchoring.get("cup_1").lost_after is None
+    else:
+        assert result.events == () and len(anchoring) == 3
