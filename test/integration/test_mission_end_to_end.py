@@ -17,6 +17,7 @@ node, the knowledge base, the behaviours' action servers and two mission nodes. 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -113,7 +114,9 @@ def run_story(data: Path, knowledge: Path, node_process, ros_probe) -> None:
     assert code == 0, account
     assert f"approach_object({mug}, kitchen)" in account  # the first plan trusted the old fact
     assert "replanning" in account
-    assert f"find_object({mug}, kitchen) succeeded" in account
+    # Aries returns the first plan it finds, not the shortest: the replan may start the search at
+    # another waypoint (driving there first) rather than where the robot stands.
+    assert re.search(rf"find_object\({mug}, \w+\) succeeded", account), account
     assert f"- object_at({mug}, kitchen)" in account  # the retraction, as it happened
     # The knowledge base tells the truth, under the same symbol: no second cup was anchored.
     assert facts(knowledge, "object_at") >= {(mug, "bedroom")}
