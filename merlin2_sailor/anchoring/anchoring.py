@@ -472,10 +472,11 @@ class Anchoring:
         failing that, born after its last sighting before it went missing (the object may have
         been moved and seen anew before its old place was found empty)."""
         since_missing = sought.missing_since if sought.missing_since is not None else sought.last_seen
-        candidates = self._search_candidates(sought, search, since_missing)
-        if not candidates and sought.lost_after is not None and sought.lost_after < since_missing:
-            candidates = self._search_candidates(sought, search, sought.lost_after)
-        return candidates[0] if len(candidates) == 1 else None
+        since_last_sighting = min(since_missing, sought.lost_after if sought.lost_after is not None else since_missing)
+        candidates = self._search_candidates(sought, search, since_last_sighting)
+        born_while_missing = [anchor for anchor in candidates if anchor.first_seen >= since_missing]
+        chosen = born_while_missing or candidates
+        return chosen[0] if len(chosen) == 1 else None
 
     def _search_candidates(self, sought: Anchor, search: Expectation, born_since: float) -> list[Anchor]:
         reach = search.radius + self.config.expectation_tolerance
@@ -566,12 +567,9 @@ class Anchoring:
         own_slack = float(extent_slack(anchor.size))
         radius = reach + max(own_slack, self._index.largest_extent_slack())
         slots = self._index.within(anchor.position.reshape(1, 3), radius)[0]
-        nearby = []
-        for other in self._index.anchors_at(slots):
-            slack = max(own_slack, float(extent_slack(other.size)))
-            if other is not anchor and np.linalg.norm(other.position - anchor.position) - slack <= reach:
-                nearby.append(other)
-        return nearby
+        distance = np.linalg.norm(self._index.positions_of(slots) - anchor.position, axis=1)
+        slack = np.maximum(self._index.extent_slacks_of(slots), own_slack)
+        return [other for other in self._index.anchors_at(slots[distance - slack <= reach]) if other is not anchor]
 
     def _merge_into(
         self, kept: Anchor, merged: Anchor, changes: _Changes, reason: str = "found by search", moved: bool = True
