@@ -31,10 +31,10 @@ from bench_matching import FEATURE_DIMENSION, GALLERY_VIEWS
 from harness import script
 from harness.results import BenchmarkResult, LinePlot, Table
 
-from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, CameraView, LifecycleConfig, Percept
-from merlin2_sailor.anchoring.percept import BoundingBox2D
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, CameraView, LifecycleConfig
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.pose import Pose
 
 LOCAL_OBJECTS = 20
 FRAMES = 100

@@ -30,11 +30,11 @@ import torch
 from harness import script
 from harness.results import BenchmarkResult, LinePlot, Table, median_seconds
 
-from merlin2_sailor.anchoring import AnchorIndex, AnchorState, MatchingTableBuilder, Percept
+from merlin2_sailor.anchoring import AnchorIndex, AnchorState, MatchingTableBuilder
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.gallery import add_to_gallery, from_bfloat16_bits
 from merlin2_sailor.anchoring.matching_network import MatchingNetwork, NetworkMatcher
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 
 FEATURE_DIMENSION = 1280
 GALLERY_VIEWS = 4

@@ -25,12 +25,12 @@ import numpy as np
 from harness import script
 from harness.results import BenchmarkResult, Table, median_seconds
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.perception.box3d import Box3D, Box3DConfig, estimate_boxes_from_depth
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGenerator
-from merlin2_sailor.perception.pose import Pose
 
 WIDTH, HEIGHT, DETECTIONS = 640, 480, 20
 REPEATS = 200

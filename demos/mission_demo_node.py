@@ -35,11 +35,11 @@ from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, SailorError
 from merlin2_sailor.knowledge import ChangeEvent, Proposition
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
 from merlin2_sailor.knowledge.pddl_writer import domain_from_store, problem_from_store
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions.perception import camera_info_to_intrinsics, pose_from_message
 from merlin2_sailor.ros.conversions.sensors import depth_to_metres, image_to_array

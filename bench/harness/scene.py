@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.pose import Pose
 
 WIDTH, HEIGHT = 640, 480
 WALL_MILLIMETRES = 5000

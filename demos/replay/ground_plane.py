@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor_demos.replay.source import WORLD_FROM_LEVEL_OPTICAL
 
 

@@ -24,9 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor_demos.replay.source import WORLD_FROM_LEVEL_OPTICAL, ReplayFrame, ReplaySource
 from merlin2_sailor_demos.replay.view_synthesis import translate_view
 from merlin2_sailor_demos.rgbd_sources import RgbdFrame, motorcycle_frames

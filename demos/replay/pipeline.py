@@ -17,8 +17,8 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringResult
 from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.percept import Percept
 from merlin2_sailor.anchoring.visibility import CameraView
+from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.detector import DETECTOR_BACKENDS, create_detector

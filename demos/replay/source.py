@@ -17,11 +17,11 @@ from typing import Any, ClassVar
 import numpy as np
 
 from merlin2_sailor.anchoring.anchoring import AnchoringConfig
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGeneratorConfig
-from merlin2_sailor.perception.pose import Pose
 
 #: Rotation taking optical-frame axes (x right, y down, z forward) into a level, z-up world frame
 #: (REP 103) whose x axis is the viewing direction: the camera-to-world rotation of a level camera.

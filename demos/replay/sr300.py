@@ -28,9 +28,9 @@ from typing import Any
 import cv2
 import numpy as np
 
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor_demos.replay.debian_data import DebianData, locate
 from merlin2_sailor_demos.replay.depth_registration import DepthCamera, register_depth
 from merlin2_sailor_demos.replay.source import WORLD_FROM_LEVEL_OPTICAL, ReplayFrame, ReplaySource

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
-from merlin2_sailor.perception.pose import Pose
 
 DEPTH_HEADER = np.dtype([("height", "<u4"), ("width", "<u4")])
 

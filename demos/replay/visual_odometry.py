@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 
 
 @dataclass(frozen=True, slots=True)

@@ -30,9 +30,9 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchoring import AnchoringConfig
 from merlin2_sailor.anchoring.visibility import VisibilityConfig
+from merlin2_sailor.contract.camera import FrustumLimits
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.box3d import Box3DConfig
-from merlin2_sailor.perception.camera_model import FrustumLimits
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGeneratorConfig
 from merlin2_sailor_demos.replay.debian_data import DebianData, locate

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 _STATE_COLOURS = {"confirmed": (30, 90, 200), "missing": (220, 40, 40), "tentative": (160, 160, 160)}  # RGB

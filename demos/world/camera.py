@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor_demos.world.geometry import Pose2D
 from merlin2_sailor_demos.world.yaml_fields import Fields
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor_demos.world.objects import COCO_CLASS_IDS, WorldObject

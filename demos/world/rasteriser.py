@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
+from merlin2_sailor.contract.camera import CameraIntrinsics
 
 #: Camera-frame depth (metres) below which geometry is clipped away.
 NEAR_PLANE = 0.05

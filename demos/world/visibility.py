@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor_demos.world.geometry import Box
 from merlin2_sailor_demos.world.rasteriser import NEAR_PLANE
 

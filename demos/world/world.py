@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor_demos.world.geometry import Box, Pose2D
 from merlin2_sailor_demos.world.gripper import GraspResult, Gripper
 from merlin2_sailor_demos.world.ground_truth_detector import DetectorNoise, GroundTruthDetector

@@ -1,9 +1,9 @@
 """The anchoring layer: percepts in, anchors (object <-> symbol links) out; ROS-free.
 
-The names below are the public API, imported on first use (PEP 562): the perceptual layer
-imports :mod:`.percept` from this package for every frame it builds, and must not pay for SciPy,
-the knowledge model or torch to do so. ``NetworkMatcher`` and the other names of
-:mod:`.matching_network` import torch when first touched, and only then.
+The names below are the public API, imported on first use (PEP 562), so that importing one
+small module of this package does not pay for SciPy, the knowledge model or torch.
+``NetworkMatcher`` and the other names of :mod:`.matching_network` import torch when first
+touched, and only then.
 """
 
 from __future__ import annotations
@@ -40,8 +40,6 @@ _EXPORTS = MappingProxyType(
         "MatchingTable": "matching_table",
         "MatchingTableBuilder": "matching_table",
         "MatchingTableConfig": "matching_table",
-        "BoundingBox2D": "percept",
-        "Percept": "percept",
         "RuleMatcher": "rule_matcher",
         "RuleMatcherConfig": "rule_matcher",
         "SymbolCounter": "symbols",
@@ -66,7 +64,6 @@ if TYPE_CHECKING:
     from merlin2_sailor.anchoring.matcher import Matcher
     from merlin2_sailor.anchoring.matching_network import MatchingNetwork, NetworkMatcher, NetworkMetadata
     from merlin2_sailor.anchoring.matching_table import MatchingTable, MatchingTableBuilder, MatchingTableConfig
-    from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
     from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
     from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
     from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig

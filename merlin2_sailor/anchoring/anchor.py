@@ -20,7 +20,7 @@ import numpy as np
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
 from merlin2_sailor.anchoring.gallery import add_to_gallery, from_bfloat16_bits
-from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
 
 

@@ -39,15 +39,15 @@ from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_expected_b
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.matching_table import Embedder, MatchingTableBuilder, MatchingTableConfig, with_embeddings
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
-from merlin2_sailor.anchoring.percept import Percept
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import SNAPSHOT_FORMAT, SNAPSHOT_VERSION, anchor_from_dict, anchor_to_dict
 from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
 from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig, should_be_visible
+from merlin2_sailor.contract.percept import Percept
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, KnowledgeError, SailorError
 from merlin2_sailor.knowledge.model import Provenance
 from merlin2_sailor.knowledge.naming import to_identifier
-from merlin2_sailor.perception.pose import Pose
 
 #: find() prefers anchors in this order of state.
 _FIND_STATE_RANK = {AnchorState.CONFIRMED: 0, AnchorState.TENTATIVE: 1, AnchorState.MISSING: 2}

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
-from merlin2_sailor.perception.pose import Pose
 
 
 class ExpectationKind(Enum):

@@ -34,7 +34,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.gallery import from_bfloat16_bits
-from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
 #: Version of the encoding above; bump it whenever an encoding changes.

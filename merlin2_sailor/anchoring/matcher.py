@@ -15,7 +15,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.features import AnchorColumns, FeatureConfig, PairFeatures, PerceptColumns, pair_features
-from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.contract.percept import Percept
 
 
 class Matcher(ABC):

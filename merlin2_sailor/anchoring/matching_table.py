@@ -38,7 +38,7 @@ from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.percept import Percept
+from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 
 

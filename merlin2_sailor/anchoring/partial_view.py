@@ -28,8 +28,8 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
-from merlin2_sailor.anchoring.percept import Percept
 from merlin2_sailor.anchoring.visibility import CameraView
+from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 
 

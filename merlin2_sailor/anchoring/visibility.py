@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from merlin2_sailor.contract.camera import CameraIntrinsics, FrustumLimits, points_in_frustum
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics, FrustumLimits, points_in_frustum
-from merlin2_sailor.perception.pose import Pose
 
 
 @dataclass(frozen=True, slots=True, eq=False)

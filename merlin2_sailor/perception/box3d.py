@@ -27,11 +27,11 @@ from enum import StrEnum
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.pixel_window import PixelWindow, pixel_window
-from merlin2_sailor.perception.pose import Pose
 
 
 @dataclass(frozen=True, slots=True)

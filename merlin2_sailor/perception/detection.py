@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D
 
 
 @dataclass(frozen=True, slots=True, eq=False)

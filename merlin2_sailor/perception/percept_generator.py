@@ -1,7 +1,7 @@
 """Detections plus an RGB-D frame and the camera pose become percepts in the world frame.
 
 This is the last step of the perceptual layer: each tracked detection gets its crop and its 3D
-box, and becomes the :class:`~merlin2_sailor.anchoring.percept.Percept` the anchoring layer
+box, and becomes the :class:`~merlin2_sailor.contract.percept.Percept` the anchoring layer
 consumes. Bad data never escapes as an exception: a frame that cannot be used (mismatched sizes,
 a non-finite stamp) drops all its detections, a detection that cannot be measured drops alone,
 and every drop carries a reason for the node to log and count.
@@ -18,7 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.box3d import (
     Box3D,
@@ -28,10 +30,8 @@ from merlin2_sailor.perception.box3d import (
     estimate_boxes_from_depth,
     estimate_boxes_from_points,
 )
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.pixel_window import pixel_window
-from merlin2_sailor.perception.pose import Pose
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D
 
 
 @dataclass(frozen=True, slots=True)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, DependencyError
 from merlin2_sailor.perception.box_overlap import suppress_cross_class_duplicates
 from merlin2_sailor.perception.coco_labels import coco_tf_label

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, DependencyError
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.detector import Detector, check_rgb_image

@@ -38,11 +38,11 @@ from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.anchoring.state_file import AnchoringStateFile
 from merlin2_sailor.anchoring.symbols import SymbolCounter
 from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
 from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
 from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.perception.stamped_buffer import StampedBuffer
 from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions import (

@@ -43,13 +43,13 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.diagnostics.topic_statistics import TopicStatistics
 from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidInputError
 from merlin2_sailor.perception.box3d import Box3DConfig, RejectionReason
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptBatch, PerceptGenerator, PerceptGeneratorConfig
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.perception.synchroniser import ApproximateTimeSynchroniser, MatchedSet, SynchroniserConfig
 from merlin2_sailor.perception.tracker import ByteTrackAdapter, ByteTrackConfig
 from merlin2_sailor.ros.conversions import (

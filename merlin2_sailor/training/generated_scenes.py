@@ -26,9 +26,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from merlin2_sailor.contract.camera import CameraIntrinsics, FrustumLimits, points_in_frustum
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics, FrustumLimits, points_in_frustum
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.training.crop_renderer import Region, ViewChange, ViewChangeLimits, render_crop
 from merlin2_sailor.training.photo_library import PhotoLibrary
 

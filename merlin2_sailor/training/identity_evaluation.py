@@ -21,7 +21,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig
 from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.errors import DependencyError
 from merlin2_sailor.training.embedding_cache import EmbeddingCache
 from merlin2_sailor.training.generated_scenes import Scene

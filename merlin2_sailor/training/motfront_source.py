@@ -45,8 +45,8 @@ from typing import Any
 
 import numpy as np
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidInputError
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.training.external_source import (
     SPLITS,
     ImageObservation,

@@ -64,7 +64,7 @@ def run_camera(arguments: argparse.Namespace) -> dict[str, Any]:
     from sensor_msgs.msg import CameraInfo
     from std_msgs.msg import Header
 
-    from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+    from merlin2_sailor.contract.percept import BoundingBox2D, Percept
     from merlin2_sailor.ros.conversions import camera_info_message, percepts_to_message, seconds_to_stamp
     from merlin2_sailor.ros.qos import SENSOR_DATA
     from merlin2_sailor_interfaces.msg import PerceptArray

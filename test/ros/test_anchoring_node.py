@@ -22,7 +22,7 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import CameraInfo
 from std_msgs.msg import Header
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.knowledge import open_store
 from merlin2_sailor.ros.conversions import camera_info_message, percepts_to_message, seconds_to_stamp
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA

@@ -32,7 +32,7 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Header
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.knowledge import Change, PddlObject, PddlType, Predicate, Proposition
 from merlin2_sailor.knowledge.naming import is_identifier
 from merlin2_sailor.knowledge.pddl_writer import domain_from_store, problem_from_store

@@ -13,10 +13,10 @@ from sensor_msgs.msg import CameraInfo, PointField
 from std_msgs.msg import Header
 from visualization_msgs.msg import Marker
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.ros.conversions import (
     array_to_image,
     array_to_point_cloud,

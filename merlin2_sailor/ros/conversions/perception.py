@@ -22,11 +22,11 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
 from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor.ros.conversions.sensors import array_to_image, image_to_array, seconds_to_stamp, stamp_to_seconds
 from merlin2_sailor_interfaces.msg import Detection as DetectionMessage
 from merlin2_sailor_interfaces.msg import DetectionArray, Mask, PerceptArray, Point2D

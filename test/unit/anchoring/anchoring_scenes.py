@@ -13,10 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D, Percept
 from merlin2_sailor.anchoring.visibility import CameraView
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
+from merlin2_sailor.contract.pose import Pose
 
 #: A small camera (160 x 120, ~77 degrees horizontal field of view) keeps depth images cheap.
 TEST_INTRINSICS = CameraIntrinsics(fx=100.0, fy=100.0, cx=79.5, cy=59.5, width=160, height=120)

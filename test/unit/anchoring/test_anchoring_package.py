@@ -22,7 +22,7 @@ def loaded_after(statement: str, modules: tuple[str, ...]) -> list[str]:
 
 
 def test_the_perceptual_layer_pays_only_for_the_percept():
-    assert loaded_after("import merlin2_sailor.anchoring.percept", ("scipy", "torch", "rclpy")) == []
+    assert loaded_after("import merlin2_sailor.contract.percept", ("scipy", "torch", "rclpy")) == []
 
 
 def test_the_core_needs_neither_torch_nor_ros():

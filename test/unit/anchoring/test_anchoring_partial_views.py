@@ -12,8 +12,8 @@ from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, AnchorState
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
-from merlin2_sailor.anchoring.percept import BoundingBox2D
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError
 
 from .anchoring_scenes import PerceptMaker, SceneObject, camera_view, flat_depth

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, LifecycleConfig
-from merlin2_sailor.anchoring.percept import BoundingBox2D
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError
 
 from .anchoring_scenes import SceneObject, camera_view

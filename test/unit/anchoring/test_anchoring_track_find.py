@@ -14,9 +14,9 @@ from merlin2_sailor.anchoring import (
     AnchorState,
     Expectation,
 )
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
 from merlin2_sailor.knowledge.model import Provenance
-from merlin2_sailor.perception.pose import Pose
 
 from .anchoring_scenes import KITCHEN, SceneObject, camera_view, flat_depth
 

@@ -8,12 +8,12 @@ import cv2
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGenerator
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor_demos.replay.depth_registration import DepthCamera, register_depth
 from merlin2_sailor_demos.replay.ground_plane import GroundPlaneCamera, foot_point, ground_depth, standing_depth
 from merlin2_sailor_demos.replay.view_synthesis import background_fill_columns, translate_view

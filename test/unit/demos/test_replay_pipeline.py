@@ -9,11 +9,11 @@ import cv2
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.pose import Pose
 from merlin2_sailor_demos.replay.pipeline import ReplayPipeline, create_replay_tracker
 from merlin2_sailor_demos.replay.runner import ReplayOptions, format_summary, run_replay
 from merlin2_sailor_demos.replay.source import WORLD_FROM_LEVEL_OPTICAL, ReplayFrame, ReplaySource, frame_indices

@@ -88,8 +88,8 @@ def test_the_map_is_a_png_with_everything_drawn(tmp_path):
 
 
 def test_anchors_are_projected_into_the_frame_where_they_are():
-    from merlin2_sailor.perception.camera_model import CameraIntrinsics
-    from merlin2_sailor.perception.pose import Pose
+    from merlin2_sailor.contract.camera import CameraIntrinsics
+    from merlin2_sailor.contract.pose import Pose
     from merlin2_sailor_demos.report.annotated_frame import AnchorInView, anchor_box, annotate_frame
 
     intrinsics = CameraIntrinsics(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)
@@ -109,8 +109,8 @@ def test_anchors_are_projected_into_the_frame_where_they_are():
 
 
 def test_an_anchor_behind_a_wall_is_not_drawn_and_one_in_view_is():
-    from merlin2_sailor.perception.camera_model import CameraIntrinsics
-    from merlin2_sailor.perception.pose import Pose
+    from merlin2_sailor.contract.camera import CameraIntrinsics
+    from merlin2_sailor.contract.pose import Pose
     from merlin2_sailor_demos.report.annotated_frame import AnchorInView, anchor_box, annotate_frame
 
     intrinsics = CameraIntrinsics(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
+from merlin2_sailor.contract.camera import CameraIntrinsics
 
 from .scenes import RgbdScene
 

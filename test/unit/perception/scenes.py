@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 
 # scripts/fetch_test_data.sh unpacks Debian's darknet package and `make test` exports where.
 DARKNET_DATA = Path(os.environ.get("SAILOR_DARKNET_DATA") or "/usr/share/darknet/data")

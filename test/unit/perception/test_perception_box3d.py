@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.box3d import (
     Box3D,
@@ -16,8 +18,6 @@ from merlin2_sailor.perception.box3d import (
     estimate_boxes_from_depth,
     estimate_boxes_from_points,
 )
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
-from merlin2_sailor.perception.pose import Pose
 
 from .scenes import MOTORCYCLE_BOX, RgbdScene, optical_camera_pose, wall_with_box_scene
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidInputError
 from merlin2_sailor.perception.box_overlap import intersection_over_union, suppress_cross_class_duplicates
 from merlin2_sailor.perception.coco_labels import COCO_TF_LABELS, coco_tf_label

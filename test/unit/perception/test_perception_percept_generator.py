@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring.percept import BoundingBox2D
+from merlin2_sailor.contract.camera import CameraIntrinsics
+from merlin2_sailor.contract.percept import BoundingBox2D
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.box3d import RejectionReason
-from merlin2_sailor.perception.camera_model import CameraIntrinsics
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGenerator, PerceptGeneratorConfig
-from merlin2_sailor.perception.pose import Pose
 
 from .scenes import MOTORCYCLE_BOX, RgbdScene, optical_camera_pose, wall_with_box_scene
 

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 
-from merlin2_sailor.perception.pose import Pose
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.training.crop_renderer import Region, ViewChange
 from merlin2_sailor.training.generated_scenes import Observation, Sample, Scene
 

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.pose import Pose
 
 
 @dataclass(frozen=True, slots=True)

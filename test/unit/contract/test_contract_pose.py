@@ -8,8 +8,8 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
-from merlin2_sailor.perception.pose import Pose
 
 QUARTER_TURN_ABOUT_Z = (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4))
 

@@ -5,10 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from merlin2_sailor.contract.camera import CameraIntrinsics, FrustumLimits, points_in_frustum
+from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.camera_model import CameraIntrinsics, FrustumLimits, points_in_frustum
 
-from .scenes import optical_camera_pose
+
+def optical_camera_pose(position: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> Pose:
+    """A camera at ``position`` looking along the world's +x (REP 103 optical axes)."""
+    rotation = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    return Pose(rotation, np.asarray(position, dtype=np.float64))
 
 INTRINSICS = CameraIntrinsics(fx=500.0, fy=400.0, cx=320.0, cy=240.0, width=640, height=480)
 
