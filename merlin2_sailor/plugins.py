@@ -83,6 +83,16 @@ class PluginTable:
                 f"The {self.kind} table names {self.entries[name]!r}, but {module_name} has no {attribute!r}."
             ) from error
 
+    def extended(self, entries: Mapping[str, str], hints: Mapping[str, str] | None = None) -> PluginTable:
+        """This table plus more plug-ins, for a layer above that adds its own (the ROS layer's stores).
+
+        The table below stays as it is, so the core never names a plug-in of a layer above it.
+        """
+        clashes = set(entries) & set(self.entries)
+        if clashes:
+            raise ValueError(f"The {self.kind} name(s) {', '.join(sorted(clashes))} are taken already.")
+        return PluginTable(self.kind, {**self.entries, **entries}, self.hint, {**self.hints, **(hints or {})})
+
     def create(self, name: str, *args: Any, **kwargs: Any) -> Any:
         """Load the plug-in called ``name`` and call it with the given arguments."""
         return self.load(name)(*args, **kwargs)

@@ -108,3 +108,14 @@ def test_the_table_is_a_frozen_copy() -> None:
     assert greeters.names == ("a",)
     with pytest.raises(TypeError):
         greeters.entries["c"] = "x:w"  # type: ignore[index]
+
+
+def test_a_layer_above_extends_a_table_without_changing_it(plugin_package: str) -> None:
+    below = PluginTable("greeter", {"light": f"{plugin_package}.light:Greeter"}, hint="below")
+    above = below.extended({"heavy": f"{plugin_package}.heavy:Greeter"}, hints={"heavy": "install heavy"})
+    assert below.names == ("light",) and above.names == ("heavy", "light")
+    assert above.create("light", "robot").text == "hello robot!"
+    with pytest.raises(DependencyError, match="install heavy$"):
+        above.load("heavy")
+    with pytest.raises(ValueError, match="taken"):
+        below.extended({"light": f"{plugin_package}.light:Greeter"})
