@@ -78,6 +78,10 @@ class Anchor:
     """The latest position perception gave, to fall back to when an expectation is retracted."""
     expectation: Expectation | None = None
     expectation_confirmed: bool = False
+    indistinguishable_from: tuple[str, ...] = ()
+    """While MISSING: the symbols of anchors that a search found and could not tell from this one
+    (look-alikes, each as likely to be it); empty when its identity is decided. The finder reports
+    it instead of guessing, so a planner learns "not found: cannot tell which" rather than a lie."""
 
     @property
     def confidence(self) -> float:

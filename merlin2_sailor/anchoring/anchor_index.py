@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
@@ -91,6 +91,32 @@ class AnchorIndex:
     def get(self, symbol: str) -> Anchor | None:
         slot = self._slot_of.get(symbol)
         return None if slot is None else self._anchors[slot]
+
+    # --- lifecycle views, derived from the anchors themselves (never kept in step by hand) ----
+
+    def of_class(self, class_name: str) -> list[Anchor]:
+        """Anchors whose voted class is ``class_name``, in symbol order."""
+        slots = np.flatnonzero(self._alive & (self._class_names == class_name))
+        return sorted(self.anchors_at(slots), key=_symbol)
+
+    def on_the_forgetting_clock(self) -> list[Anchor]:
+        """MISSING anchors, and tentative ones not seen where they should have been: the anchors
+        the lifecycle may forget, in symbol order."""
+        return sorted(
+            (a for a in self if a.state is AnchorState.MISSING or a.missing_since is not None), key=_symbol
+        )
+
+    def missing(self) -> list[Anchor]:
+        """MISSING anchors, in symbol order."""
+        return sorted((a for a in self if a.state is AnchorState.MISSING), key=_symbol)
+
+    def expected(self) -> list[Anchor]:
+        """Anchors with an action's expectation on them, in symbol order."""
+        return sorted((a for a in self if a.expectation is not None), key=_symbol)
+
+    def visible(self) -> list[Anchor]:
+        """Anchors seen in the latest processed frame."""
+        return [a for a in self if a.visible]
 
     def anchors_at(self, slots: np.ndarray) -> list[Anchor]:
         return [self._anchors[int(slot)] for slot in slots]  # type: ignore[misc]
@@ -229,3 +255,7 @@ class AnchorIndex:
     def _mark_pending(self, slot: int) -> None:
         self._pending.add(slot)
         self._is_pending[slot] = True
+
+
+def _symbol(anchor: Anchor) -> str:
+    return anchor.symbol

@@ -29,6 +29,9 @@ class AnchorEventKind(Enum):
     """Missing for too long, or forgotten on request: the anchor and its symbol are gone."""
     RETRACTED = "retracted"
     """An expected location was contradicted by what the camera saw."""
+    AMBIGUOUS = "ambiguous"
+    """The evidence cannot tell which of several anchors an object is (look-alikes): no merge was
+    made, and ``details`` name the candidates; the identity stays unknown rather than guessed."""
 
 
 @dataclass(frozen=True, slots=True)

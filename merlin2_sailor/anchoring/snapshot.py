@@ -9,7 +9,7 @@ of lists of numbers (~25 kB of JSON each).
 from __future__ import annotations
 
 import base64
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -57,6 +57,7 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "perceived_position": anchor.perceived_position.tolist(),
         "expectation": None if anchor.expectation is None else anchor.expectation.describe(),
         "expectation_confirmed": bool(anchor.expectation_confirmed),
+        "indistinguishable_from": list(anchor.indistinguishable_from),
     }
 
 
@@ -86,6 +87,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             perceived_position=_vector(data.get("perceived_position", data["position"]), "perceived_position"),
             expectation=None if data.get("expectation") is None else Expectation.from_description(data["expectation"]),
             expectation_confirmed=bool(data.get("expectation_confirmed", False)),
+            indistinguishable_from=tuple(str(symbol) for symbol in data.get("indistinguishable_from") or ()),
         )
     except (KeyError, ValueError, TypeError) as error:
         name = data.get("symbol", "?") if isinstance(data, Mapping) else "?"
@@ -111,3 +113,37 @@ def _gallery(data: Mapping[str, Any] | None) -> np.ndarray | None:
     if len(shape) != 2 or gallery.size != shape[0] * shape[1]:
         raise ValueError(f"gallery bytes do not fill the shape {shape}")
     return gallery.reshape(shape).astype(GALLERY_DTYPE)
+
+
+def snapshot_of(anchors: Iterable[Anchor], world_frame: str, stamp: float | None) -> dict[str, Any]:
+    """Every anchor as plain, JSON-safe data, in symbol order, with the frame they live in."""
+    return {
+        "format": SNAPSHOT_FORMAT,
+        "version": SNAPSHOT_VERSION,
+        "world_frame": world_frame,
+        "stamp": stamp,
+        "anchors": [anchor_to_dict(anchor) for anchor in sorted(anchors, key=lambda a: a.symbol)],
+    }
+
+
+def anchors_of_snapshot(snapshot: Mapping[str, Any], world_frame: str) -> tuple[list[Anchor], float | None]:
+    """The anchors of a snapshot (forgotten ones included) and its stamp; refuses a snapshot of
+    another format, version or frame, and one naming a symbol twice."""
+    if not isinstance(snapshot, Mapping) or snapshot.get("format") != SNAPSHOT_FORMAT:
+        raise InvalidInputError(f"Not an anchors snapshot (expected format {SNAPSHOT_FORMAT!r}).")
+    if snapshot.get("version") != SNAPSHOT_VERSION:
+        raise InvalidInputError(
+            f"Anchors snapshot version {snapshot.get('version')!r} is not supported "
+            f"(this code reads version {SNAPSHOT_VERSION})."
+        )
+    if snapshot.get("world_frame", world_frame) != world_frame:
+        raise InvalidInputError(
+            f"The snapshot's anchors are in frame {snapshot['world_frame']!r}, this core anchors in "
+            f"{world_frame!r}; positions would be meaningless."
+        )
+    anchors = [anchor_from_dict(data) for data in snapshot.get("anchors", ())]
+    symbols = [anchor.symbol for anchor in anchors]
+    if len(set(symbols)) != len(symbols):
+        raise InvalidInputError("The anchors snapshot names a symbol twice.")
+    stamp = snapshot.get("stamp")
+    return anchors, None if stamp is None else float(stamp)

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, LifecycleConfig
+from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError
@@ -92,22 +93,22 @@ def test_two_objects_seen_apart_are_never_merged(make_anchoring, maker):
     assert books(anchoring) == [("book_1", AnchorState.MISSING), ("book_2", AnchorState.CONFIRMED)]
 
 
-@pytest.mark.parametrize(("offset", "merged"), [(0.2, True), (0.35, False)])
-def test_only_a_newcomer_within_the_reappearance_distance_is_merged(maker, offset, merged):
-    """A strict matcher (0.1 m) refuses the percept, so the book is anchored anew beside its
-    missing anchor: 0.2 m away it is taken for it, 0.35 m away (farther than the 0.25 m
-    reappearance distance) it is not. A cup seen at the book's very place never is."""
-    anchoring = Anchoring(
-        AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=2, missed_frames_to_missing=1)),
-        RuleMatcher(RuleMatcherConfig(position_sigma=0.1, drift_speed=0.0, maximum_sigma=0.1)),
-    )
+@pytest.mark.parametrize(("offset", "merged"), [(0.1, True), (0.45, False)])
+def test_only_a_newcomer_within_the_reappearance_distance_is_merged(make_anchoring, maker, offset, merged):
+    """The false detection takes the missing anchor and the book, back beside its old place, is
+    anchored anew: 0.1 m away it is taken for the missing one (which the false box pulled 0.1 m
+    the other way), 0.45 m away (farther than the 0.25 m reappearance distance) it is not. A
+    cup seen at the book's very place never is."""
+    anchoring = make_anchoring()
     for frame in range(2):
         see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
     see(anchoring, [], 1.0)
     beside = np.array(BOOK.position) + (0.0, offset, 0.0)
     cup = SceneObject("cup", "cup", BOOK.position)
-    for frame in range(3):
-        stamp = 2.0 + frame * FRAME
+    see(anchoring, [maker.percept(BOOK, 4.0, position=beside), maker.percept(FALSE_BOOK, 4.0),
+                    maker.percept(cup, 4.0)], 4.0)
+    for frame in range(1, 3):
+        stamp = 4.0 + frame * FRAME
         see(anchoring, [maker.percept(BOOK, stamp, position=beside), maker.percept(cup, stamp)], stamp)
     states = {anchor.symbol: anchor.state for anchor in anchoring.anchors}
     if merged:
@@ -117,33 +118,50 @@ def test_only_a_newcomer_within_the_reappearance_distance_is_merged(maker, offse
                           "cup_1": AnchorState.CONFIRMED}
 
 
-def test_a_large_object_seen_again_in_part_is_merged_and_keeps_its_whole_view(maker):
-    """The near end of a bicycle, cut by the image's edge, is centred 0.8 m from the whole
-    bicycle's centre: its extent explains that, as in matching. The merged anchor keeps the
-    centre and size of its whole views; a part says less about them."""
+def test_a_newcomer_the_matcher_rejects_is_never_merged(maker):
+    """The merge asks the matching function itself: with a strict matcher (0.1 m) a book anchored
+    0.2 m from a missing one is not it, however near the reappearance distance says it is."""
     anchoring = Anchoring(
         AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=2, missed_frames_to_missing=1)),
         RuleMatcher(RuleMatcherConfig(position_sigma=0.1, drift_speed=0.0, maximum_sigma=0.1)),
     )
+    for frame in range(2):
+        see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
+    see(anchoring, [], 1.0)
+    beside = np.array(BOOK.position) + (0.0, 0.2, 0.0)
+    for frame in range(3):
+        stamp = 2.0 + frame * FRAME
+        see(anchoring, [maker.percept(BOOK, stamp, position=beside)], stamp)
+    assert books(anchoring) == [("book_1", AnchorState.MISSING), ("book_2", AnchorState.CONFIRMED)]
+
+
+def test_a_large_object_seen_again_in_part_is_merged_and_keeps_its_whole_view(make_anchoring, maker):
+    """The near end of a bicycle, cut by the image's edge, is centred 0.8 m from the whole
+    bicycle's centre: its extent explains that, as in matching. When a false detection takes the
+    missing anchor in the frame the near end comes back, the near end is anchored anew, then
+    merged; the merged anchor keeps the centre and size of its whole views (a part says less)."""
+    anchoring = make_anchoring()
     bicycle = SceneObject("bicycle", "bicycle", (3.0, 0.0, 0.5), (0.35, 1.6, 1.0))
     near_end = SceneObject("bicycle_end", "bicycle", (3.0, -0.8, 0.5), (0.27, 0.08, 1.0))
+    false_bicycle = SceneObject("false_bicycle", "bicycle", (3.1, 0.1, 0.5), (0.4, 1.6, 1.0))
     for frame in range(2):
         see(anchoring, [maker.percept(bicycle, frame * FRAME)], frame * FRAME)
     see(anchoring, [], 1.0)
     at_the_edge = BoundingBox2D(center_x=6.0, center_y=60.0, width=12.0, height=60.0)
-    for frame in range(2):
-        stamp = 2.0 + frame * FRAME
-        see(anchoring, [dataclasses.replace(maker.percept(near_end, stamp), box=at_the_edge)], stamp)
+    first = see(anchoring, [dataclasses.replace(maker.percept(near_end, 2.0), box=at_the_edge),
+                            maker.percept(false_bicycle, 2.0)], 2.0)
+    assert first.percept_symbols == ("bicycle_2", "bicycle_1")
+    see(anchoring, [dataclasses.replace(maker.percept(near_end, 2.0 + FRAME), box=at_the_edge)], 2.0 + FRAME)
     assert books(anchoring) == [("bicycle_1", AnchorState.CONFIRMED)]
     kept = anchoring.get("bicycle_1")
-    np.testing.assert_allclose(kept.position, bicycle.position, atol=0.05)
+    np.testing.assert_allclose(kept.position, bicycle.position, atol=0.15)
     np.testing.assert_allclose(kept.size, bicycle.size, rtol=0.1)
-    assert kept.times_seen == 4
+    assert kept.times_seen == 5
 
 
 def test_the_reappearance_merge_can_be_turned_off_and_is_validated(maker):
     anchoring = Anchoring(AnchoringConfig(
-        reappearance_distance=0.0,
+        repair=RepairConfig(reappearance_distance=0.0),
         lifecycle=LifecycleConfig(confirm_after=2, missed_frames_to_missing=1)))
     for frame in range(2):
         see(anchoring, [maker.percept(BOOK, frame * FRAME)], frame * FRAME)
@@ -152,4 +170,6 @@ def test_the_reappearance_merge_can_be_turned_off_and_is_validated(maker):
     see(anchoring, [maker.percept(BOOK, 4.0 + FRAME)], 4.0 + FRAME)
     assert len(anchoring) == 2
     with pytest.raises(ConfigurationError, match="reappearance_distance"):
-        AnchoringConfig(reappearance_distance=float("nan"))
+        RepairConfig(reappearance_distance=float("nan"))
+    with pytest.raises(ConfigurationError, match="ambiguity_margin"):
+        RepairConfig(ambiguity_margin=1.5)

@@ -393,7 +393,7 @@ def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_e
     """Moved, and seen at once in the living room beside another mug, before the robot found its
     old place empty: the newcomer is older than the missing anchor's loss, but younger than its
     last sighting. If the other mug was first seen after that sighting too, nothing tells the two
-    apart without appearance, and the search merges neither."""
+    apart without appearance: the search merges neither, and says so, naming both."""
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
     other_mug = SceneObject("green_mug", "cup", (1.5, 5.5, 0.8))
@@ -416,4 +416,7 @@ def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_e
         np.testing.assert_allclose(anchoring.get("cup_1").position, moved_to, atol=0.05)
         assert anchoring.get("cup_1").lost_after is None
     else:
-        assert result.events == () and len(anchoring) == 3
+        assert [(e.kind, e.symbol, e.details["candidates"]) for e in result.events] == [
+            (AnchorEventKind.AMBIGUOUS, "cup_1", "cup_2,cup_3")]
+        assert len(anchoring) == 3 and anchoring.get("cup_1").state is AnchorState.MISSING
+        assert anchoring.get("cup_1").indistinguishable_from == ("cup_2", "cup_3")

@@ -1,0 +1,94 @@
+"""Anchor against anchor, scored by the matching function itself: the evidence behind a merge.
+
+Identity repair asks "is this newer anchor the older, lost one, seen again?". That is the question
+the matching function M answers for a percept and an anchor, so it is answered by the very same
+matcher (the learned one compares appearance; the rules only class, place and time): the newer
+anchor plays the percept, as it was when it first appeared (its first sighting's stamp, so the
+time feature measures the gap since the lost anchor was last seen), once per view in its
+appearance gallery, and the best view counts, as the gallery's nearest view does in matching.
+
+For a search, where the lost object is sought is a disc rather than a point: the lost anchor is
+measured from that disc (anywhere in it counts as in place), as the matching table measures a
+searched anchor; every other feature is unchanged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
+from merlin2_sailor.anchoring.gallery import from_bfloat16_bits
+from merlin2_sailor.anchoring.matcher import Matcher
+
+
+@dataclass(frozen=True, slots=True)
+class SearchedDisc:
+    """Where a lost object is being looked for: anywhere within ``radius`` metres of ``centre``."""
+
+    centre: np.ndarray
+    radius: float
+
+
+def identity_scores(
+    matcher: Matcher, candidates: Sequence[Anchor], lost: Anchor, disc: SearchedDisc | None = None
+) -> np.ndarray:
+    """M(candidate as first perceived, lost) for each candidate: a (len(candidates),) array in [0, 1]."""
+    if not candidates:
+        return np.zeros(0)
+    percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance)
+    anchors = AnchorColumns.from_anchors([lost])
+    if disc is None:
+        anchors = dataclasses.replace(anchors, perceived_positions=None, search_radii=None)
+    else:
+        anchors = dataclasses.replace(
+            anchors,
+            positions=np.asarray(disc.centre, dtype=np.float64).reshape(1, 3),
+            perceived_positions=None,
+            search_radii=np.array([float(disc.radius)]),
+        )
+    rows = np.arange(len(owners))
+    features = pair_features(
+        percepts, anchors, rows, np.zeros(len(owners), dtype=np.intp), matcher.feature_config,
+        with_appearance=matcher.uses_appearance,
+    )
+    per_view = matcher.score_pairs(features)
+    best = np.zeros(len(candidates))
+    np.maximum.at(best, owners, per_view)
+    return best
+
+
+def _candidates_as_percepts(candidates: Sequence[Anchor], with_views: bool) -> tuple[PerceptColumns, np.ndarray]:
+    """One pseudo-percept per gallery view of each candidate (one, without embedding, if it has
+    none); returns the columns and, per row, the candidate it stands for."""
+    owners: list[int] = []
+    views: list[np.ndarray | None] = []
+    for number, anchor in enumerate(candidates):
+        gallery = anchor.gallery if with_views and anchor.gallery is not None and len(anchor.gallery) else None
+        entries = [None] if gallery is None else list(from_bfloat16_bits(gallery))
+        owners.extend([number] * len(entries))
+        views.extend(entries)
+    owner_array = np.asarray(owners, dtype=np.intp)
+    chosen = [candidates[owner] for owner in owners]
+    known = np.array([view is not None for view in views], dtype=bool)
+    embeddings = None
+    if known.any():
+        dimension = next(view for view in views if view is not None).shape[-1]
+        embeddings = np.zeros((len(views), dimension), dtype=np.float32)
+        for row, view in enumerate(views):
+            if view is not None:
+                embeddings[row] = view
+    columns = PerceptColumns(
+        class_names=np.array([a.class_name for a in chosen], dtype=object),
+        positions=np.array([a.position for a in chosen], dtype=np.float64).reshape(-1, 3),
+        sizes=np.array([a.size for a in chosen], dtype=np.float64).reshape(-1, 3),
+        stamps=np.array([a.first_seen for a in chosen], dtype=np.float64),
+        tracker_ids=np.array([""] * len(chosen), dtype=object),
+        embeddings=embeddings,
+        has_embedding=known,
+    )
+    return columns, owner_array

@@ -1,0 +1,229 @@
+"""Identity repair: when a newer anchor is an older, lost one seen again, decided by evidence.
+
+Matching decides identity frame by frame; two situations escape it, and both leave one object
+under two symbols unless repaired:
+
+- **a search** (top-down Find) for a MISSING anchor: the object was moved while the robot was
+  elsewhere and, seen again from afar, anchored anew, because nothing then said it was the lost
+  one. The search says where to look (a disc), so the newer anchor may now be recognised as it;
+- **a reappearance**: a MISSING anchor's object comes back where it was lost, but another percept
+  of its class (a false detection with a large box, the near end of a bicycle) took the old
+  anchor in that very frame, so the real object became a newcomer.
+
+Every decision here is pure: it reads anchors and the anchor index and returns a :class:`Merge`
+(``merged`` was ``kept`` all along), an :class:`Undecided` (the evidence cannot tell which of
+several anchors it is), or nothing. The coordinator (:class:`~.anchoring.Anchoring`) applies them.
+
+The evidence is the matching function itself (:func:`~.anchor_comparison.identity_scores`): the
+learned matcher compares appearance, so a mug of another colour is never merged into a missing
+mug's symbol; the rules compare only class, place and time. Besides a score at or above the
+match threshold, a candidate must be possible at all:
+
+- same class, nothing expected of it, trusted (confirmed, or confirmed once and missing again);
+- born no earlier than the lost anchor's last sighting before it went missing: two anchors seen
+  side by side at one time are two objects, whatever they look like.
+
+A candidate is taken only when it is clearly the best (by ``ambiguity_margin``) for the lost
+anchor, *and* the lost anchor is clearly the best of every other MISSING anchor the candidate
+could be: two missing look-alike mugs and one mug found cannot be told apart, and then the
+decision is :class:`Undecided`, naming the candidates, instead of a guess.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.features import extent_slack
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.errors import ConfigurationError
+
+
+@dataclass(frozen=True, slots=True)
+class RepairConfig:
+    """``reappearance_distance`` (m): how close to a MISSING anchor a newcomer of its class must
+    be confirmed to be considered as it reappearing (below the 0.3 m between books on a shelf;
+    0 turns reappearance merges off); ``ambiguity_margin``: how much better than every rival a
+    candidate must score to be taken (scores closer than this cannot tell the two apart)."""
+
+    reappearance_distance: float = 0.25
+    ambiguity_margin: float = 0.15
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.reappearance_distance) and self.reappearance_distance >= 0.0):
+            raise ConfigurationError(
+                "anchoring reappearance_distance must be a non-negative number of metres (0 turns the merge off), "
+                f"got {self.reappearance_distance}."
+            )
+        if not (0.0 <= self.ambiguity_margin < 1.0):
+            raise ConfigurationError(f"anchoring ambiguity_margin must be in [0, 1), got {self.ambiguity_margin}.")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Merge:
+    """``merged`` is ``kept`` seen again: ``kept`` keeps its symbol and takes ``merged``'s views.
+    ``moved``: found elsewhere (by a search), so ``merged``'s place is where the object is now."""
+
+    kept: Anchor
+    merged: Anchor
+    score: float
+    reason: str
+    moved: bool
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Undecided:
+    """The evidence cannot decide: each of the MISSING anchors ``lost`` may be any of ``found``
+    (one lost mug, two look-alikes found; or two lost look-alikes, one found). ``scores`` are
+    the matching function's, ``lost[0]`` against each of ``found`` then the rivals against
+    ``found[0]``."""
+
+    lost: tuple[Anchor, ...]
+    found: tuple[Anchor, ...]
+    scores: tuple[float, ...]
+    reason: str
+
+
+Decision = Merge | Undecided
+
+
+class IdentityRepair:
+    """Decides merges with one matcher, one match threshold and one :class:`RepairConfig`."""
+
+    def __init__(self, matcher: Matcher, match_threshold: float, config: RepairConfig, search_tolerance: float) -> None:
+        self.matcher = matcher
+        self.match_threshold = match_threshold
+        self.config = config
+        self.search_tolerance = search_tolerance
+        """Metres added to a search's radius: an object at its edge, measured with noise, is in."""
+
+    # --- searches ---------------------------------------------------------------------------
+
+    def decide_search(self, sought: Anchor, search: Expectation, index: AnchorIndex) -> Decision | None:
+        """What a search for the MISSING ``sought`` within ``search``'s disc has found, if anything."""
+        if sought.state is not AnchorState.MISSING or not search.is_search:
+            return None
+        disc = SearchedDisc(search.position, search.radius + self.search_tolerance)
+        reach = disc.radius
+        candidates = [
+            anchor for anchor in index.of_class(sought.class_name)
+            if self._possible(anchor, sought, include_missing=True)
+            and float(np.linalg.norm(anchor.position[:2] - disc.centre[:2])) <= reach
+        ]
+        return self._decide(sought, candidates, index, disc, reason="found by search", moved=True)
+
+    # --- reappearances ----------------------------------------------------------------------
+
+    def decide_reappearances(
+        self, lost: Iterable[Anchor], newcomers: Iterable[Anchor], index: AnchorIndex
+    ) -> list[Decision]:
+        """Merges (or undecided cases) for MISSING anchors that confirmed newcomers may be.
+
+        ``lost``: anchors that went missing this frame; ``newcomers``: anchors confirmed for the
+        first time this frame. Each newcomer brings the MISSING anchors near it into question,
+        so the check runs whichever of the two came last.
+        """
+        if self.config.reappearance_distance <= 0.0:
+            return []
+        in_question = {anchor.symbol: anchor for anchor in lost}
+        for newcomer in newcomers:
+            for anchor in self._near(newcomer, index):
+                if anchor.state is AnchorState.MISSING:
+                    in_question.setdefault(anchor.symbol, anchor)
+        decisions: list[Decision] = []
+        taken: set[str] = set()
+        for symbol in sorted(in_question):
+            missing = in_question[symbol]
+            if missing.state is not AnchorState.MISSING or missing.expectation is not None:
+                continue
+            candidates = [
+                anchor for anchor in self._near(missing, index)
+                if anchor.symbol not in taken and anchor.state is AnchorState.CONFIRMED
+                and self._possible(anchor, missing, include_missing=False)
+            ]
+            decision = self._decide(missing, candidates, index, None, reason="reappeared where it went missing",
+                                    moved=False)
+            if isinstance(decision, Merge):
+                taken.add(decision.merged.symbol)
+            if decision is not None:
+                decisions.append(decision)
+        return decisions
+
+    # --- shared -----------------------------------------------------------------------------
+
+    def _decide(
+        self, lost: Anchor, candidates: Sequence[Anchor], index: AnchorIndex, disc: SearchedDisc | None,
+        reason: str, moved: bool,
+    ) -> Decision | None:
+        if not candidates:
+            return None
+        scores = identity_scores(self.matcher, candidates, lost, disc)
+        order = np.argsort(-scores, kind="stable")
+        plausible = [int(k) for k in order if scores[k] >= self.match_threshold]
+        if not plausible:
+            return None
+        best = plausible[0]
+        alike = [k for k in plausible if scores[k] > scores[best] - self.config.ambiguity_margin]
+        if len(alike) > 1:
+            found = tuple(candidates[k] for k in alike)
+            return Undecided((lost,), found, tuple(float(scores[k]) for k in alike),
+                             f"{lost.symbol} may be any of {', '.join(a.symbol for a in found)}: they look alike")
+        chosen = candidates[best]
+        rivals = self._rivals(chosen, lost, index, disc)
+        if rivals:
+            rival_scores = [float(identity_scores(self.matcher, [chosen], rival, disc)[0]) for rival in rivals]
+            missing = (lost, *rivals)
+            return Undecided(missing, (chosen,), (float(scores[best]), *rival_scores),
+                             f"{chosen.symbol} may be any of {', '.join(a.symbol for a in missing)}: they look alike")
+        return Merge(lost, chosen, float(scores[best]), reason, moved)
+
+    def _rivals(self, candidate: Anchor, lost: Anchor, index: AnchorIndex, disc: SearchedDisc | None) -> list[Anchor]:
+        """Other MISSING anchors the candidate is as likely to be as ``lost`` (judged the same way:
+        from the same disc for a search, in place for a reappearance)."""
+        others = [
+            anchor for anchor in index.of_class(candidate.class_name)
+            if anchor is not lost and anchor is not candidate and anchor.state is AnchorState.MISSING
+            and anchor.expectation is None and self._possible(candidate, anchor, include_missing=True)
+        ]
+        if disc is None:
+            near = {anchor.symbol for anchor in self._near(candidate, index)}
+            others = [anchor for anchor in others if anchor.symbol in near]
+        if not others:
+            return []
+        own = float(identity_scores(self.matcher, [candidate], lost, disc)[0])
+        return [
+            anchor for anchor in others
+            if float(identity_scores(self.matcher, [candidate], anchor, disc)[0])
+            > max(own - self.config.ambiguity_margin, self.match_threshold - 1e-12)
+        ]
+
+    @staticmethod
+    def _possible(candidate: Anchor, lost: Anchor, include_missing: bool) -> bool:
+        """Whether ``candidate`` can be ``lost`` at all (before any score): see the module docstring."""
+        allowed = (AnchorState.CONFIRMED, AnchorState.MISSING) if include_missing else (AnchorState.CONFIRMED,)
+        last_sighting = lost.lost_after if lost.lost_after is not None else lost.last_seen
+        return (
+            candidate is not lost
+            and candidate.class_name == lost.class_name
+            and candidate.state in allowed
+            and candidate.expectation is None
+            and candidate.first_seen >= last_sighting
+        )
+
+    def _near(self, anchor: Anchor, index: AnchorIndex) -> list[Anchor]:
+        """Other anchors whose centre lies within the reappearance distance of this one's, plus
+        what either's extent explains (views of a large object are not centred alike)."""
+        reach = self.config.reappearance_distance
+        own_slack = float(extent_slack(anchor.size))
+        radius = reach + max(own_slack, index.largest_extent_slack())
+        slots = index.within(anchor.position.reshape(1, 3), radius)[0]
+        distance = np.linalg.norm(index.positions_of(slots) - anchor.position, axis=1)
+        slack = np.maximum(index.extent_slacks_of(slots), own_slack)
+        return [other for other in index.anchors_at(slots[distance - slack <= reach]) if other is not anchor]

@@ -1,0 +1,58 @@
+"""Carrying out identity repair's decisions (:mod:`.identity_repair`) on the anchors.
+
+A merge keeps the older symbol, since that is the one the planner and the knowledge base know:
+the kept anchor takes the merged one's views, sightings and class votes, and, when the object
+was found elsewhere, its place. An undecided case changes no identity: each lost anchor records
+what it cannot be told from, and an AMBIGUOUS event says so.
+"""
+
+from __future__ import annotations
+
+from merlin2_sailor.anchoring.anchor import AnchorState
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.events import AnchorEventKind
+from merlin2_sailor.anchoring.frame_changes import FrameChanges
+from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.identity_repair import Decision, Merge
+from merlin2_sailor.anchoring.observation import drop_expectation
+
+
+def apply_decision(decision: Decision | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig) -> None:
+    """Carry out a merge, or report what could not be decided."""
+    if decision is None:
+        return
+    if not isinstance(decision, Merge):
+        involved = [anchor.symbol for anchor in (*decision.lost, *decision.found)]
+        for lost in decision.lost:
+            others = tuple(symbol for symbol in involved if symbol != lost.symbol)
+            if others == lost.indistinguishable_from:
+                continue  # said already; a search re-decides each frame something new is confirmed
+            lost.indistinguishable_from = others
+            changes.event(AnchorEventKind.AMBIGUOUS, lost.symbol, reason=decision.reason,
+                          candidates=",".join(lost.indistinguishable_from),
+                          scores=",".join(f"{score:.2f}" for score in decision.scores))
+        return
+    kept, merged = decision.kept, decision.merged
+    still_missing = merged.state is AnchorState.MISSING
+    was_visible = merged.visible
+    kept.absorb_anchor(merged, fusion, decision.moved)
+    index.remove(merged.symbol)
+    merged.visible = False
+    kept.visible = was_visible
+    drop_expectation(kept)
+    kept.indistinguishable_from = ()
+    # A merged anchor that is missing leaves the kept one missing, on its clock: the object
+    # was last seen under that symbol, and seeing it again confirms it as usual.
+    kept.state = AnchorState.MISSING if still_missing else AnchorState.CONFIRMED
+    kept.missing_since = merged.missing_since if still_missing else None
+    kept.lost_after = merged.lost_after if still_missing else None
+    kept.missed_frames = merged.missed_frames if still_missing else 0
+    kept.recovery_sightings = merged.recovery_sightings if still_missing else 0
+    merged.state = AnchorState.FORGOTTEN
+    index.refresh(kept)
+    changes.forgotten.append(merged)
+    changes.reacquired.append(kept)
+    changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"{decision.reason}: it is {kept.symbol}",
+                  score=round(decision.score, 3))
+    if not still_missing:
+        changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=decision.reason, merged=merged.symbol)

@@ -1,0 +1,96 @@
+"""Acquire and reacquire: one percept becomes a new anchor, or is fused into the one it matched.
+
+These are the paper's two outcomes of matching, plus what perception says about an action's
+expectation on the anchor it reacquires (perception outranks expectation: seen near the expected
+place confirms it, seen elsewhere retracts it). The coordinator decides *which* happens; these
+functions say what each does to the anchor and which events it makes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.events import AnchorEventKind
+from merlin2_sailor.anchoring.expectation import ExpectationKind
+from merlin2_sailor.anchoring.frame_changes import FrameChanges
+from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting
+from merlin2_sailor.anchoring.partial_view import smaller_than_known
+from merlin2_sailor.anchoring.percept_checks import position_text
+from merlin2_sailor.contract.percept import Percept
+from merlin2_sailor.knowledge.model import Provenance
+
+
+def acquire(
+    symbol: str, percept: Percept, changes: FrameChanges, fusion: FusionConfig, lifecycle: LifecycleConfig,
+    partial: bool = False,
+) -> Anchor:
+    """A new anchor named ``symbol`` from one percept (the caller indexes it)."""
+    anchor = Anchor.from_percept(symbol, percept, percept.embedding, fusion, partial)
+    became_confirmed = after_sighting(anchor, lifecycle)
+    changes.acquired.append(anchor)
+    changes.event(AnchorEventKind.ACQUIRED, symbol, class_name=anchor.class_name, tracker_id=percept.tracker_id,
+                  at=position_text(anchor.position))
+    if became_confirmed:
+        changes.event(AnchorEventKind.CONFIRMED, symbol, reason="seen", times_seen=anchor.times_seen)
+        changes.confirmed_newcomers.append(anchor)
+    return anchor
+
+
+def reacquire(
+    anchor: Anchor, percept: Percept, changes: FrameChanges, fusion: FusionConfig, lifecycle: LifecycleConfig,
+    expectation_tolerance: float, continued: bool, partial: bool = False,
+) -> None:
+    """Fuse ``percept`` into ``anchor`` (the caller refreshes the index)."""
+    # A search for a missing anchor ends only once the anchor is back (see after_sighting):
+    # one false detection in the searched disc must not end the search.
+    searching = anchor.expectation is not None and anchor.expectation.is_search
+    if anchor.expectation is not None and not searching:
+        resolve_expectation(anchor, percept, changes, expectation_tolerance)
+    was_missing = anchor.state is AnchorState.MISSING
+    missing_since = anchor.missing_since
+    partial = partial or smaller_than_known(percept, anchor)
+    anchor.absorb(percept, percept.embedding, fusion, partial)
+    became_confirmed = after_sighting(anchor, lifecycle)
+    if anchor.state is AnchorState.MISSING:
+        anchor.missing_since = missing_since  # not back yet: still on the clock that forgets it
+    else:
+        anchor.indistinguishable_from = ()  # seen as itself: its identity is decided again
+        if searching:
+            resolve_expectation(anchor, percept, changes, expectation_tolerance)
+    changes.reacquired.append(anchor)
+    changes.event(
+        AnchorEventKind.REACQUIRED, anchor.symbol, was_missing=was_missing, tracker_id=percept.tracker_id,
+        tracker_continued=continued,
+    )
+    if became_confirmed:
+        changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="seen", times_seen=anchor.times_seen)
+        if not was_missing:
+            changes.confirmed_newcomers.append(anchor)
+
+
+def resolve_expectation(anchor: Anchor, percept: Percept, changes: FrameChanges, tolerance: float) -> None:
+    """Perception outranks expectation: seen near the expected place confirms, elsewhere retracts."""
+    expectation = anchor.expectation
+    assert expectation is not None
+    distance = float(np.linalg.norm(np.asarray(percept.position) - anchor.position))
+    details = {"expectation": expectation.describe(), "distance": distance}
+    if distance > tolerance + expectation.radius:
+        changes.event(AnchorEventKind.RETRACTED, anchor.symbol, reason="seen elsewhere", **details)
+        drop_expectation(anchor)
+        anchor.position = anchor.perceived_position.copy()
+        return
+    if not anchor.expectation_confirmed:
+        changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="expectation", **details)
+    if expectation.kind is ExpectationKind.CARRIED:
+        anchor.expectation_confirmed = True  # still carried: keep following the robot
+    else:
+        drop_expectation(anchor)
+
+
+def drop_expectation(anchor: Anchor) -> None:
+    """The anchor's position is perception's again."""
+    anchor.expectation = None
+    anchor.expectation_confirmed = False
+    anchor.provenance = Provenance.PERCEIVED

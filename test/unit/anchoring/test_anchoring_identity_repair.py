@@ -1,0 +1,165 @@
+"""Identity repair decides by the matching function's evidence, appearance included, or not at all.
+
+The matcher here is a small appearance-aware one (the rules, times how alike the two crops'
+embeddings are), so these tests exercise the repair logic that any appearance matcher, the
+learned one included, goes through; the rule matcher cannot tell a green mug from a blue one,
+and is covered by the search and reappearance tests beside this file.
+
+Situations: a look-alike moved while its twin stays; an object removed while another of its
+class, another colour, is seen in the searched room; two look-alikes found for one lost mug;
+two lost look-alikes and one found; a newcomer of another look beside a missing anchor; a
+search that goes on while the object is anchored anew.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
+from merlin2_sailor.anchoring.features import FeatureConfig, PairFeatures
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+
+from .anchoring_scenes import PerceptMaker, SceneObject, camera_view
+
+FRAME = 1.0 / 15.0
+KITCHEN_MUG = SceneObject("blue_mug", "cup", (2.0, 0.3, 0.8))
+TWIN = SceneObject("blue_twin", "cup", (2.0, -0.3, 0.8), looks_like="blue_mug")
+LIVING_ROOM = np.array((1.5, 6.0, 0.8))
+GREEN_MUG = SceneObject("green_mug", "cup", (1.9, 6.2, 0.8))
+
+
+class AppearanceRules(Matcher):
+    """Rules times appearance: 1 for the same look, near 0 for another (unit embeddings)."""
+
+    uses_appearance = True
+
+    def __init__(self) -> None:
+        self.rules = RuleMatcher()
+
+    @property
+    def feature_config(self) -> FeatureConfig:
+        return self.rules.feature_config
+
+    def score_pairs(self, features: PairFeatures) -> np.ndarray:
+        scores = self.rules.score_pairs(features)
+        known = features.appearance_known
+        likeness = np.ones(len(features))
+        likeness[known] = np.exp(-((features.appearance_distance[known] / 2.0) ** 2) * 4.0)
+        return scores * likeness
+
+
+@pytest.fixture
+def anchoring() -> Anchoring:
+    lifecycle = LifecycleConfig(confirm_after=2, missed_frames_to_missing=1, forget_after=600.0)
+    return Anchoring(AnchoringConfig(lifecycle=lifecycle), AppearanceRules())
+
+
+@pytest.fixture
+def maker() -> PerceptMaker:
+    return PerceptMaker(seed=11, appearance_noise=0.02)
+
+
+def see(anchoring, maker, items, stamp, camera=True, positions=None):
+    percepts = [maker.percept(item, stamp, position=(positions or {}).get(item.identity)) for item in items]
+    return anchoring.process(percepts, camera_view() if camera else None, stamp)
+
+
+def seen_twice(anchoring, maker, items, start, camera=True, positions=None):
+    for frame in range(2):
+        see(anchoring, maker, items, start + frame * FRAME, camera, positions)
+
+
+def search_living_room(anchoring, symbol, stamp):
+    return anchoring.expect(symbol, Expectation.at(LIVING_ROOM, stamp, "living_room", "find", radius=1.5))
+
+
+def kinds(result):
+    return [(event.kind, event.symbol) for event in result.events]
+
+
+def test_a_look_alike_moved_while_its_twin_stays_is_found_under_its_own_symbol(anchoring, maker):
+    seen_twice(anchoring, maker, [KITCHEN_MUG, TWIN], 0.0)
+    see(anchoring, maker, [TWIN], 1.0)  # the kitchen: the twin is there, the other mug is not
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 2.0, camera=False, positions={"blue_mug": LIVING_ROOM})
+    result = search_living_room(anchoring, "cup_1", 3.0)
+    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, "cup_1")]
+    np.testing.assert_allclose(anchoring.get("cup_1").position, LIVING_ROOM, atol=0.05)
+    assert anchoring.get("cup_2").state is AnchorState.CONFIRMED  # the twin keeps its own symbol
+
+
+def test_a_removed_object_is_never_reported_found_as_another_of_its_class(anchoring, maker):
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    see(anchoring, maker, [], 1.0)
+    seen_twice(anchoring, maker, [GREEN_MUG], 2.0, camera=False)  # a green mug, in the searched room
+    result = search_living_room(anchoring, "cup_1", 3.0)
+    assert result.events == ()
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    assert anchoring.get("cup_2").state is AnchorState.CONFIRMED
+    # The rules alone cannot tell the two apart: they take the green mug for the lost one.
+    rules = Anchoring(AnchoringConfig(lifecycle=anchoring.config.lifecycle), RuleMatcher())
+    seen_twice(rules, maker, [KITCHEN_MUG], 0.0)
+    see(rules, maker, [], 1.0)
+    seen_twice(rules, maker, [GREEN_MUG], 2.0, camera=False)
+    assert kinds(search_living_room(rules, "cup_1", 3.0))[0] == (AnchorEventKind.FORGOTTEN, "cup_2")
+
+
+def test_two_look_alikes_found_for_one_lost_mug_are_reported_not_guessed(anchoring, maker):
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    see(anchoring, maker, [], 1.0)
+    first = SceneObject("first", "cup", (1.2, 5.6, 0.8), looks_like="blue_mug")
+    second = SceneObject("second", "cup", (1.8, 6.4, 0.8), looks_like="blue_mug")
+    seen_twice(anchoring, maker, [first, second], 2.0, camera=False)
+    result = search_living_room(anchoring, "cup_1", 3.0)
+    assert [(e.kind, e.symbol, e.details["candidates"]) for e in result.events] == [
+        (AnchorEventKind.AMBIGUOUS, "cup_1", "cup_2,cup_3")]
+    lost = anchoring.get("cup_1")
+    assert lost.state is AnchorState.MISSING and lost.indistinguishable_from == ("cup_2", "cup_3")
+    assert len(anchoring) == 3
+    again = search_living_room(anchoring, "cup_1", 3.5)
+    assert again.events == ()  # said once, not every time the search is renewed
+
+
+def test_one_mug_found_for_two_lost_look_alikes_is_reported_not_guessed(anchoring, maker):
+    seen_twice(anchoring, maker, [KITCHEN_MUG, TWIN], 0.0)
+    see(anchoring, maker, [], 1.0)  # both gone
+    assert {a.state for a in anchoring.anchors} == {AnchorState.MISSING}
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 2.0, camera=False, positions={"blue_mug": LIVING_ROOM})
+    result = search_living_room(anchoring, "cup_1", 3.0)
+    assert [(e.kind, e.symbol) for e in result.events] == [
+        (AnchorEventKind.AMBIGUOUS, "cup_1"), (AnchorEventKind.AMBIGUOUS, "cup_2")]
+    assert anchoring.get("cup_1").indistinguishable_from == ("cup_2", "cup_3")
+    assert anchoring.get("cup_3").state is AnchorState.CONFIRMED and len(anchoring) == 3
+
+
+def test_a_newcomer_of_another_look_beside_a_missing_anchor_is_not_it(anchoring, maker):
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    see(anchoring, maker, [], 1.0)
+    green_in_place = SceneObject("green_mug", "cup", KITCHEN_MUG.position)
+    seen_twice(anchoring, maker, [green_in_place], 2.0)
+    assert {a.symbol: a.state for a in anchoring.anchors} == {
+        "cup_1": AnchorState.MISSING, "cup_2": AnchorState.CONFIRMED}
+
+
+def test_a_search_under_way_recognises_the_object_when_it_is_anchored_anew(anchoring, maker):
+    """The search was announced before the moved mug was seen: it was anchored anew (the camera
+    saw it from afar, outside the searched disc's reach of the matching gate); the confirmation
+    itself brings it into question, and the search finds it."""
+    seen_twice(anchoring, maker, [KITCHEN_MUG, GREEN_MUG], 0.0)
+    see(anchoring, maker, [GREEN_MUG], 1.0)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    assert search_living_room(anchoring, "cup_1", 1.5).events == ()  # nothing new yet: the green one is older
+    moved = np.array((1.5, 8.0, 0.8))  # 2 m from the centre: beyond the disc, within its tolerance
+    found = None
+    for frame in range(2):
+        result = see(anchoring, maker, [KITCHEN_MUG], 2.0 + frame * FRAME, camera=False,
+                     positions={"blue_mug": moved})
+        found = found or next((e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN), None)
+    assert found is not None and found.details["reason"].endswith("it is cup_1")
+    cup = anchoring.get("cup_1")
+    assert cup.state is AnchorState.CONFIRMED and cup.expectation is None
+    np.testing.assert_allclose(cup.position, moved, atol=0.05)
+    assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and len(anchoring) == 2
