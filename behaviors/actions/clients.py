@@ -73,6 +73,9 @@ class AnchorReport:
     last_seen: float
     """When it was last perceived, in the anchoring node's clock (seconds)."""
     times_seen: int = 0
+    indistinguishable_from: tuple[str, ...] = ()
+    """While missing: anchors a search found that the anchoring layer cannot tell from this one
+    (look-alikes). Its identity is unknown: a finder must not claim any of them is it."""
 
     def seen_since(self, baseline: AnchorReport | None) -> bool:
         """Whether the camera reacquired this anchor after ``baseline`` was taken (None: ever),

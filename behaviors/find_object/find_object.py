@@ -16,7 +16,9 @@ blackboard), the robot searches for it:
 3. On success the robot stays at that stop, and the behaviour writes ``robot_at(<stop>)``
    (DECLARED) in the knowledge base itself: the dispatcher only knows ``origin``. The anchored
    facts (``object_at``, ``missing``) are perception's to update.
-4. Not found anywhere: RETURNING to ``origin`` (so the ``robot_at(origin)`` the dispatcher
+4. Not found anywhere, or found only among look-alikes the anchoring layer cannot tell apart (the
+   anchor reports ``indistinguishable_from``; the search then ends, since guessing would put the
+   wrong object under the symbol): RETURNING to ``origin`` (so the ``robot_at(origin)`` the dispatcher
    restores after an abort is true; ``return_on_failure``), then GIVING_UP: aborted, naming
    every stop searched. A stop the robot cannot reach is a warning and the search goes on.
 """
@@ -73,6 +75,9 @@ class Search:
     """Each candidate anchor as it was when the search began: a sighting must be newer."""
     next_stop: int = 0
     unreachable: list[str] = field(default_factory=list)
+    indistinguishable_from: tuple[str, ...] = ()
+    """Anchors the anchoring layer found and cannot tell from the sought one (look-alikes): the
+    search ends there, unsuccessful, rather than claim one of them is it."""
 
     @property
     def sought(self) -> str:
@@ -116,7 +121,7 @@ def plan_search(state: BehaviorState, blackboard: Blackboard) -> str:
 
 def next_stop(state: BehaviorState, blackboard: Blackboard) -> str:
     search: Search = blackboard[SEARCH_KEY]
-    if search.next_stop >= len(search.stops):
+    if search.next_stop >= len(search.stops) or search.indistinguishable_from:
         return EXHAUSTED
     stop = search.stops[search.next_stop]
     search.next_stop += 1
@@ -193,6 +198,12 @@ def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
                 warn(context, blackboard, f"cannot withdraw the search for {search.symbol} at {stop}: {error}")
         if state.is_canceled():
             return CANCEL
+        sought = context.anchoring.get_anchor(search.symbol) if search.symbol else None
+        if sought is not None and sought.indistinguishable_from:
+            search.indistinguishable_from = sought.indistinguishable_from
+            context.log("warning", f"{search.sought}: cannot tell it from {', '.join(sought.indistinguishable_from)} "
+                                "(they look alike); its identity is unknown")
+            return NOT_HERE
         context.log("info", f"{search.sought} is not at {stop}")
         return NOT_HERE
     declare_robot_at(context.store, stop)
@@ -215,6 +226,9 @@ def give_up(state: BehaviorState, blackboard: Blackboard) -> str:
     search: Search = blackboard[SEARCH_KEY]
     searched = [stop for stop in search.stops if stop not in search.unreachable]
     message = f"{search.sought} was not found at {', '.join(searched) or 'any stop'}"
+    if search.indistinguishable_from:
+        others = ", ".join(search.indistinguishable_from)
+        message = f"{search.sought} cannot be told from {others} (they look alike): its identity is unknown"
     if search.unreachable:
         message += f" (could not reach {', '.join(search.unreachable)})"
     return abort(blackboard, message)

@@ -66,6 +66,8 @@ class AnchorEventWording:
             return f"anchor {symbol}{what} missing"
         if kind == "retracted":
             return f"anchor {symbol}{what} retracted{why}"
+        if kind == "ambiguous":
+            return f"anchor {symbol}{what} identity unknown{why}"
         if kind == "forgotten" and symbol in self._confirmed:
             self._confirmed.discard(symbol)
             self._missing.discard(symbol)

@@ -36,6 +36,7 @@ def anchor_report(message: AnchorMessage) -> AnchorReport:
         position=position,
         last_seen=stamp_to_seconds(message.last_seen),
         times_seen=int(message.times_seen),
+        indistinguishable_from=tuple(str(symbol) for symbol in message.indistinguishable_from),
     )
 
 

@@ -39,6 +39,7 @@ _ACCOUNTED = {
     AnchorEventKind.MISSING: "missing",
     AnchorEventKind.FORGOTTEN: "forgotten",
     AnchorEventKind.RETRACTED: "retracted",
+    AnchorEventKind.AMBIGUOUS: "ambiguous",
 }
 
 

@@ -94,6 +94,22 @@ def test_find_that_finds_nothing_aborts_after_every_waypoint_and_returns_to_its_
     assert robot_locations(robot.store) == ("a",)  # untouched by the behaviour
 
 
+def test_find_that_finds_only_look_alikes_it_cannot_tell_apart_ends_unsuccessful_saying_so(
+    robot: FakeRobot,
+) -> None:
+    """The anchoring layer found two mugs either of which may be cup_1: the search stops at the
+    first stop where that is known and aborts naming them, instead of claiming one."""
+    from dataclasses import replace
+
+    robot.anchoring.anchors["cup_1"] = replace(robot.anchoring.anchors["cup_1"],
+                                               indistinguishable_from=("cup_4", "cup_5"))
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT
+    assert blackboard[REASON_KEY] == "cup_1 cannot be told from cup_4, cup_5 (they look alike): its identity is unknown"
+    assert stops(robot) == ["b", "a"]  # searched b, then back to its origin
+    assert FOUND_SYMBOL_KEY not in blackboard
+
+
 def test_find_goes_on_past_a_waypoint_it_cannot_reach(robot: FakeRobot) -> None:
     robot.navigation.unreachable.add((0.0, 0.0))
     robot.world["cup_1"] = (2.0, 3.0)
