@@ -16,17 +16,17 @@ from typing import Any
 from rclpy.node import Node
 
 from merlin2_sailor.errors import SailorError
-from merlin2_sailor.knowledge import ChangeEvent, KnowledgeBase, open_store
+from merlin2_sailor.knowledge import ChangeEvent, KnowledgeBase
 from merlin2_sailor.ros.conversions.anchoring import EVENT_KIND_TO_MESSAGE
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS
+from merlin2_sailor.ros.stores import open_store
 from merlin2_sailor_behaviors.mission.account import AnchorEventWording, describe_fact_changes
 from merlin2_sailor_behaviors.mission.goals import parse_goals
 from merlin2_sailor_behaviors.mission.session import ForwardToRosLogger, MissionSession, SessionConfig
 from merlin2_sailor_interfaces.msg import AnchorEventArray
 
-ROS_PREFIX = "ros://"
 _KIND_NAMES = {number: kind.value for kind, number in EVENT_KIND_TO_MESSAGE.items()}
 
 
@@ -43,11 +43,7 @@ def anchor_event_lines(wording: AnchorEventWording, message: AnchorEventArray) -
 
 def open_knowledge_base(location: str, timeout: float = 5.0) -> KnowledgeBase:
     """``ros:///merlin2`` (the knowledge_base node) or any location open_store knows."""
-    if location.startswith(ROS_PREFIX):
-        from merlin2_sailor.ros.knowledge_base_client import RemoteKnowledgeBase
-
-        return RemoteKnowledgeBase(namespace=location.removeprefix(ROS_PREFIX) or "/", timeout=timeout)
-    return open_store(location)
+    return open_store(location, timeout=timeout)
 
 
 class MissionNode(Node):

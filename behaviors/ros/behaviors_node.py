@@ -32,10 +32,10 @@ from rclpy.node import Node
 from merlin2_sailor.errors import ConfigurationError, KnowledgeError
 from merlin2_sailor.knowledge import Change, KnowledgeBase, PddlObject
 from merlin2_sailor.knowledge.grounding import GroundingConfig
-from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
 from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
+from merlin2_sailor.ros.stores import open_store
 from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.actions.context import BehaviorConfig, BehaviorContext
 from merlin2_sailor_behaviors.actions.domain import LOCATION_TYPE
@@ -184,11 +184,7 @@ class BehaviorsNode(Node):
         return BehaviorConfig(**values)
 
     def _open_store(self, location: str, timeout: float) -> KnowledgeBase:
-        if location.startswith(ROS_PREFIX):
-            from merlin2_sailor.ros.knowledge_base_client import RemoteKnowledgeBase
-
-            return RemoteKnowledgeBase(namespace=location.removeprefix(ROS_PREFIX) or "/", timeout=timeout)
-        return open_store(location)
+        return open_store(location, timeout=timeout)
 
     def _publish_progress(self) -> None:
         for server in self._servers:

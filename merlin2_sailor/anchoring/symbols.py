@@ -2,9 +2,11 @@
 
 A symbol (``cup_3``) is the name the planner knows an object by, so it must never be handed out
 twice, not even across a restart: a plan made before the restart may still mention ``cup_3``.
-That is why the anchoring core does not count by itself but asks a *symbol factory*, normally
-:meth:`merlin2_sailor.knowledge.store.KnowledgeBase.new_symbol`, whose counter lives in the
-database. :class:`SymbolCounter` is the in-memory stand-in for tests, benchmarks and offline use.
+That is why the anchoring core does not count by itself but asks a *symbol factory*. The
+anchoring node owns the one counter: a :class:`SymbolCounter` whose indices it saves in its state
+folder (``state_file.py``) before a new symbol can reach anyone, and moves past every symbol it
+restores or finds in the knowledge base. Without a state folder, a :class:`SymbolCounter` alone
+serves tests, benchmarks and offline use.
 """
 
 from __future__ import annotations
@@ -14,12 +16,12 @@ from collections.abc import Callable, Iterable, Mapping
 from merlin2_sailor.knowledge.naming import symbol as symbol_name
 from merlin2_sailor.knowledge.naming import to_identifier
 
-#: A callable ``class_name -> fresh symbol``, e.g. ``KnowledgeBase.new_symbol``.
+#: A callable ``class_name -> fresh symbol``, e.g. a :class:`SymbolCounter`.
 SymbolFactory = Callable[[str], str]
 
 
 class SymbolCounter:
-    """Per-class counters starting at 1, like the knowledge stores' persistent ones.
+    """Per-class counters starting at 1, keyed by the class's PDDL identifier.
 
     The counters belong to the instance (never to the class), so two anchoring cores in one
     process, or two tests, never share a sequence.

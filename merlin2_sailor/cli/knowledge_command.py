@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import argparse
 
-from merlin2_sailor.knowledge import ItemKind, KnowledgeBase, open_store
+from merlin2_sailor.knowledge import ItemKind, KnowledgeBase
 from merlin2_sailor.knowledge.pddl_writer import domain_from_store, problem_from_store
+from merlin2_sailor.ros.stores import open_store
 
 DEFAULT_STORE = "ros:///merlin2"
 

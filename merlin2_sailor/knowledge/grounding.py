@@ -378,7 +378,7 @@ class Grounding:
             if anchor.symbol in result:
                 raise InvalidInputError(
                     f"two anchors share the symbol {anchor.symbol!r}; symbols must be unique, "
-                    "take them from KnowledgeBase.new_symbol()"
+                    "take them from one persistent counter (the anchoring node's SymbolCounter)"
                 )
             name = anchor.symbol
             facts = [Proposition(config.seen_predicate, (name,), provenance=Provenance.PERCEIVED)]

@@ -12,36 +12,45 @@ changes through the DAOs in dependency order. What KANT cannot hold is said plai
 * no transactions: a batch that fails half-way leaves the changes written so far (in dependency
   order, so the knowledge base stays consistent);
 * no supertypes: types are flat, children of ``object``;
-* no provenance: facts this adapter wrote keep theirs while it runs; others read as DECLARED;
-* no symbol counter: the next index follows the highest one among KANT's objects and the ones
-  this adapter handed out, so a symbol deleted before a restart could be handed out again; use
-  the SQLite or MongoDB store where that guarantee matters.
+* no provenance: facts this adapter wrote keep theirs while it runs; others read as DECLARED.
+
+By location, ``kant+mongodb://host:port/database`` opens KANT's MongoDB DAO family on that URI.
+KANT's ROS 2 family needs a ROS node of the caller's: build its factory and pass it to
+:class:`KantStore` directly.
 """
 
 from __future__ import annotations
 
 import importlib
-import re
 from collections.abc import Hashable, Iterable, Sequence
 from types import ModuleType
 from typing import Any
 
-from merlin2_sailor.errors import DependencyError, KnowledgeError
+from merlin2_sailor.errors import ConfigurationError, DependencyError, KnowledgeError
 from merlin2_sailor.knowledge import model
 from merlin2_sailor.knowledge.changes import ChangeEvent, ItemKind, Operation
 from merlin2_sailor.knowledge.mirrored_store import MirroredStore
 from merlin2_sailor.knowledge.model import KnowledgeItem, Proposition
 from merlin2_sailor.knowledge.rules import KnowledgeState
+from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS
+
+#: ``kant+mongodb://host:port/database``: KANT's MongoDB family; what follows ``kant+`` is KANT's URI.
+MONGODB_SCHEME = "kant+mongodb://"
+KANT_MISSING = (
+    "the KANT store needs MERLIN2's kant_dto and kant_dao packages; build KANT in your "
+    "ROS 2 workspace (https://github.com/uleroboticsgroup/kant) and source it"
+)
 
 
 def import_kant_dto() -> ModuleType:
+    return _import_kant("kant_dto")
+
+
+def _import_kant(module_name: str) -> ModuleType:
     try:
-        return importlib.import_module("kant_dto")
+        return importlib.import_module(module_name)
     except ImportError as error:
-        raise DependencyError(
-            "the KANT store needs MERLIN2's kant_dto and kant_dao packages; build KANT in your "
-            "ROS 2 workspace (https://github.com/uleroboticsgroup/kant) and source it"
-        ) from error
+        raise DependencyError(f"{KANT_MISSING} ({error})") from error
 
 
 class KantStore(MirroredStore):
@@ -64,8 +73,19 @@ class KantStore(MirroredStore):
         self._provenances: dict[Hashable, model.Provenance] = {}
         # Items of the batch being written, for DTOs of things the same batch deleted.
         self._batch_items: dict[tuple[ItemKind, Hashable], KnowledgeItem] = {}
-        self._highest_index: dict[str, int] = {}
         self._open_mirror()
+
+    @classmethod
+    def from_location(cls, location: str, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> KantStore:
+        """``kant+mongodb://host:port/database``: KANT's DAOs over its MongoDB family."""
+        uri = location.removeprefix("kant+")
+        if location == MONGODB_SCHEME or not location.startswith(MONGODB_SCHEME):
+            raise ConfigurationError(
+                f"{location!r} names no KANT database; write kant+mongodb://host:port/database"
+            )
+        dao_factory_module = _import_kant("kant_dao.dao_factory")
+        families = dao_factory_module.DaoFamilies
+        return cls(dao_factory_module.DaoFactoryMethod().create_dao_factory(families.MONGO, uri=uri))
 
     # The port, reading KANT afresh each time.
 
@@ -115,14 +135,6 @@ class KantStore(MirroredStore):
                     self._provenances[event.item.key] = event.item.provenance
                 else:
                     self._provenances.pop(event.item.key, None)
-
-    def _reserve_symbol_index(self, class_identifier: str) -> int:
-        pattern = re.compile(rf"^{re.escape(class_identifier)}_(\d+)$")
-        in_kant = [int(match.group(1)) for obj in self._daos[ItemKind.OBJECT].get_all() or []
-                   if (match := pattern.match(obj.get_name()))]
-        index = max([self._highest_index.get(class_identifier, 0), *in_kant]) + 1
-        self._highest_index[class_identifier] = index
-        return index
 
     def _close_database(self) -> None:
         """KANT's DAOs hold no resources of ours."""

@@ -9,25 +9,22 @@ from collections.abc import Iterable, Sequence
 from merlin2_sailor.knowledge.changes import ChangeEvent
 from merlin2_sailor.knowledge.mirrored_store import MirroredStore
 from merlin2_sailor.knowledge.model import KnowledgeItem
+from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS
 
 
 class MemoryStore(MirroredStore):
     """A knowledge base with no database behind its in-memory state."""
 
-    def __init__(self) -> None:
-        super().__init__()
-        self._last_symbol_index: dict[str, int] = {}
+    @classmethod
+    def from_location(cls, location: str, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> "MemoryStore":
+        """``memory``: nothing to find, nothing to wait for."""
+        return cls()
 
     def _load(self) -> Iterable[KnowledgeItem]:
         return ()
 
     def _persist(self, events: Sequence[ChangeEvent]) -> None:
         """Nothing to write: memory already holds the batch."""
-
-    def _reserve_symbol_index(self, class_identifier: str) -> int:
-        index = self._last_symbol_index.get(class_identifier, 0) + 1
-        self._last_symbol_index[class_identifier] = index
-        return index
 
     def _close_database(self) -> None:
         """Nothing to release."""

@@ -16,7 +16,6 @@ from collections.abc import Hashable, Iterable, Sequence
 from merlin2_sailor.errors import KnowledgeError
 from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind
 from merlin2_sailor.knowledge.model import KnowledgeItem, Proposition
-from merlin2_sailor.knowledge.naming import to_identifier
 from merlin2_sailor.knowledge.rules import KnowledgeState
 from merlin2_sailor.knowledge.store import KnowledgeBase, Subscriber, Unsubscribe
 
@@ -53,10 +52,6 @@ class MirroredStore(KnowledgeBase):
         """
 
     @abstractmethod
-    def _reserve_symbol_index(self, class_identifier: str) -> int:
-        """Increment and return the class's counter, atomically, starting from 1."""
-
-    @abstractmethod
     def _close_database(self) -> None:
         """Release the connection."""
 
@@ -91,11 +86,6 @@ class MirroredStore(KnowledgeBase):
                 raise
             self._notify(transaction.events)
             return transaction.events
-
-    def next_symbol_index(self, class_name: str) -> int:
-        with self._lock:
-            self._require_open()
-            return self._reserve_symbol_index(to_identifier(class_name))
 
     def subscribe(self, subscriber: Subscriber) -> Unsubscribe:
         with self._lock:

@@ -18,11 +18,10 @@ from merlin2_sailor.knowledge.codec import COLLECTION_NAMES, from_document, key_
 from merlin2_sailor.knowledge.mirrored_store import MirroredStore
 from merlin2_sailor.knowledge.model import KnowledgeItem
 from merlin2_sailor.knowledge.rules import SAVE_ORDER
+from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS
 
 DEFAULT_DATABASE = "merlin2_sailor"
 """Used when the URI names no database."""
-
-SYMBOL_COUNTERS = "symbol_counters"
 
 
 def _import_pymongo() -> Any:
@@ -39,12 +38,11 @@ def _import_pymongo() -> Any:
 class MongoStore(MirroredStore):
     """A knowledge base persisted in a MongoDB database, e.g. ``mongodb://localhost:27017/kb``."""
 
-    def __init__(self, uri: str, timeout_seconds: float = 5.0) -> None:
+    def __init__(self, uri: str, timeout_seconds: float = DEFAULT_TIMEOUT_SECONDS) -> None:
         super().__init__()
         pymongo = _import_pymongo()
         self._errors = pymongo.errors.PyMongoError
         self._bulk_requests = (pymongo.ReplaceOne, pymongo.DeleteOne)
-        self._return_updated = pymongo.ReturnDocument.AFTER
         self.uri = uri
         try:
             self._client = pymongo.MongoClient(
@@ -58,6 +56,11 @@ class MongoStore(MirroredStore):
                 f"cannot use MongoDB knowledge base {uri!r} ({error}); start the server or "
                 "check the URI (mongodb://host:port/database)"
             ) from error
+
+    @classmethod
+    def from_location(cls, location: str, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> "MongoStore":
+        """A MongoDB URI, ``mongodb://host:port/database`` or ``mongodb+srv://...``, as it is."""
+        return cls(location, timeout_seconds=timeout)
 
     def _load(self) -> Iterable[KnowledgeItem]:
         items = []
@@ -89,20 +92,6 @@ class MongoStore(MirroredStore):
                 f"could not write to MongoDB knowledge base {self.uri!r} ({error}); the batch "
                 "was not applied in memory and may be partly written: reopen the store to reload"
             ) from error
-
-    def _reserve_symbol_index(self, class_identifier: str) -> int:
-        try:
-            counter = self._database[SYMBOL_COUNTERS].find_one_and_update(
-                {"_id": class_identifier},
-                {"$inc": {"last_index": 1}},
-                upsert=True,
-                return_document=self._return_updated,
-            )
-        except self._errors as error:
-            raise KnowledgeError(
-                f"could not reserve a symbol in MongoDB {self.uri!r} ({error}); check the server"
-            ) from error
-        return int(counter["last_index"])
 
     def _close_database(self) -> None:
         self._client.close()

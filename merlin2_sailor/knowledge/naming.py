@@ -139,12 +139,13 @@ def require_identifier(text: str, role: str) -> str:
 def symbol(class_name: str, index: int) -> str:
     """Name the anchor number ``index`` of a class, e.g. ``symbol("cup", 3) == "cup_3"``.
 
-    The index comes from a store's persistent counter, so the pair never repeats and the symbol
-    stays stable for as long as the anchor lives.
+    The index comes from a persistent counter (the anchoring node's
+    :class:`~merlin2_sailor.anchoring.symbols.SymbolCounter`), so the pair never repeats and the
+    symbol stays stable for as long as the anchor lives.
     """
     if isinstance(index, bool) or not isinstance(index, int) or index < 0:
         raise KnowledgeError(
             f"symbol index must be a non-negative integer, got {index!r}; "
-            "take it from KnowledgeBase.next_symbol_index()"
+            "take it from a persistent counter such as the anchoring node's SymbolCounter"
         )
     return f"{to_identifier(class_name)}_{index}"

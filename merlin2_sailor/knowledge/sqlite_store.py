@@ -13,15 +13,21 @@ from collections.abc import Iterable, Sequence
 from itertools import groupby
 from pathlib import Path
 
-from merlin2_sailor.errors import KnowledgeError
+from merlin2_sailor.errors import ConfigurationError, KnowledgeError
 from merlin2_sailor.knowledge.changes import ChangeEvent, Operation
 from merlin2_sailor.knowledge.codec import COLLECTION_NAMES, from_document, key_text, to_document
 from merlin2_sailor.knowledge.mirrored_store import MirroredStore
 from merlin2_sailor.knowledge.model import KnowledgeItem
 from merlin2_sailor.knowledge.rules import SAVE_ORDER
+from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS
 
 SCHEMA_VERSION = 1
-"""Stored in ``PRAGMA user_version``, so a future layout can recognise and migrate this one."""
+"""Stored in ``PRAGMA user_version``, so a future layout can recognise and migrate this one.
+
+Files written before the anchoring node owned the symbol counters hold an unused
+``symbol_counters`` table; it is left alone."""
+
+SCHEME = "sqlite://"
 
 
 class SqliteStore(MirroredStore):
@@ -44,6 +50,14 @@ class SqliteStore(MirroredStore):
                 "directory exists and is writable"
             ) from error
 
+    @classmethod
+    def from_location(cls, location: str, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> "SqliteStore":
+        """``sqlite:///absolute/kb.db``, ``sqlite://relative/kb.db`` or ``sqlite://:memory:``."""
+        path = location.removeprefix(SCHEME)
+        if not path:
+            raise ConfigurationError(f"{location!r} names no file; write sqlite:///absolute/path.db or sqlite://:memory:")
+        return cls(path)
+
     def _create_schema(self) -> None:
         connection = self._connection
         version = connection.execute("PRAGMA user_version").fetchone()[0]
@@ -60,10 +74,6 @@ class SqliteStore(MirroredStore):
                     f"CREATE TABLE IF NOT EXISTS {table} "
                     "(key TEXT PRIMARY KEY, document TEXT NOT NULL)"
                 )
-            connection.execute(
-                "CREATE TABLE IF NOT EXISTS symbol_counters "
-                "(class_name TEXT PRIMARY KEY, last_index INTEGER NOT NULL)"
-            )
             connection.execute(f"PRAGMA user_version={SCHEMA_VERSION}")
 
     def _load(self) -> Iterable[KnowledgeItem]:
@@ -100,21 +110,6 @@ class SqliteStore(MirroredStore):
                 f"could not write to SQLite knowledge base {self.path!r} ({error}); "
                 "nothing of the batch was applied"
             ) from error
-
-    def _reserve_symbol_index(self, class_identifier: str) -> int:
-        try:
-            with self._connection:
-                (index,) = self._connection.execute(
-                    "INSERT INTO symbol_counters (class_name, last_index) VALUES (?, 1) "
-                    "ON CONFLICT(class_name) DO UPDATE SET last_index = last_index + 1 "
-                    "RETURNING last_index",
-                    (class_identifier,),
-                ).fetchone()
-        except sqlite3.Error as error:
-            raise KnowledgeError(
-                f"could not reserve a symbol in {self.path!r} ({error}); check the file"
-            ) from error
-        return int(index)
 
     def _close_database(self) -> None:
         self._connection.close()

@@ -20,7 +20,9 @@ from merlin2_sailor.knowledge.model import (
     Predicate,
     Proposition,
 )
-from merlin2_sailor.knowledge.naming import symbol, to_identifier
+
+DEFAULT_TIMEOUT_SECONDS = 5.0
+"""How long a store that talks to a server (MongoDB, the knowledge_base node) waits for it."""
 
 Subscriber = Callable[[Sequence[ChangeEvent]], None]
 """Called once per applied batch with the events it caused; never with an empty sequence."""
@@ -99,14 +101,6 @@ class KnowledgeBase(ABC):
         """
 
     @abstractmethod
-    def next_symbol_index(self, class_name: str) -> int:
-        """Reserve the next anchor index of a class; no index is ever handed out twice.
-
-        Persistent stores keep the counter in their database, so a symbol forgotten before a
-        restart (``cup_3``) is not given to a different object after it.
-        """
-
-    @abstractmethod
     def subscribe(self, subscriber: Subscriber) -> Unsubscribe:
         """Call ``subscriber`` after every batch that changed something."""
 
@@ -114,14 +108,13 @@ class KnowledgeBase(ABC):
     def close(self) -> None:
         """Release the database; closing twice is harmless."""
 
-    def new_symbol(self, class_name: str) -> str:
-        """A fresh, stable PDDL name for a new anchor of a class, e.g. ``cup_4``.
+    @classmethod
+    def from_location(cls, location: str, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> "KnowledgeBase":
+        """Open the store that ``location`` names; its scheme chose this class (see ``stores``).
 
-        The counter is keyed by the class's identifier, so "dining table" and "dining_table",
-        which would give the same symbols, share one counter and never collide.
+        ``timeout`` bounds the wait for a server, for the stores that have one.
         """
-        prefix = to_identifier(class_name)
-        return symbol(prefix, self.next_symbol_index(prefix))
+        raise NotImplementedError(f"{cls.__name__} is not opened by location; construct it directly")
 
     def __enter__(self) -> "KnowledgeBase":
         return self

@@ -1,55 +1,69 @@
-"""Open a knowledge base by name, so the choice of store is one line of configuration.
+"""Open a knowledge base by its location, so the choice of store is one line of configuration.
 
-Store modules are imported only when chosen: a robot using SQLite never needs pymongo. The
-``ros://`` store is the knowledge_base node reached over ROS services; its client lives with the
-other ROS code and is imported by name only when chosen, so this layer stays ROS-free.
+A location is ``scheme://rest`` or a bare name (``memory``); its scheme picks a store class from
+:data:`STORES`, a table of ``"module:Class"`` strings, so only the chosen store is imported (a
+robot on SQLite never needs pymongo or KANT), and the class opens the location with its
+``from_location``. The table holds the ROS-free stores only: the ROS layer extends it with
+``ros://`` (the knowledge_base node) in :mod:`merlin2_sailor.ros.stores`, so this layer never
+names a module above it. Adding a store is one module with a ``KnowledgeBase`` subclass that has a
+``from_location``, plus one line here (or in the table of the layer it belongs to).
 """
 
+from __future__ import annotations
+
 from merlin2_sailor.errors import ConfigurationError
-from merlin2_sailor.knowledge.store import KnowledgeBase
+from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS, KnowledgeBase
+from merlin2_sailor.plugins import PluginTable
 
 MEMORY = "memory"
-SQLITE_PREFIX = "sqlite://"
-MONGODB_PREFIXES = ("mongodb://", "mongodb+srv://")
+SCHEME_SEPARATOR = "://"
+#: Only for ros/anchoring_node.py until it opens its store through merlin2_sailor.ros.stores.open_store;
+#: then delete it (this layer has no ros:// store).
 ROS_PREFIX = "ros://"
 
+#: Scheme -> "module:Class" of every ROS-free store.
+STORES = PluginTable(
+    "knowledge store",
+    {
+        MEMORY: "merlin2_sailor.knowledge.memory_store:MemoryStore",
+        "sqlite": "merlin2_sailor.knowledge.sqlite_store:SqliteStore",
+        "mongodb": "merlin2_sailor.knowledge.mongo_store:MongoStore",
+        "mongodb+srv": "merlin2_sailor.knowledge.mongo_store:MongoStore",
+        "kant+mongodb": "merlin2_sailor.knowledge.kant_store:KantStore",
+    },
+)
 
-def open_store(location: str = MEMORY) -> KnowledgeBase:
-    """Open the store a location names.
+#: What the error for an unknown location shows, so a user sees the forms, not only the names.
+LOCATION_FORMS = (
+    "memory, sqlite:///absolute/path.db, sqlite://relative/path.db, mongodb://host:port/database, "
+    "kant+mongodb://host:port/database; from ROS nodes and `sailor` commands also ros:///namespace "
+    "(the knowledge_base node, merlin2_sailor.ros.stores)"
+)
 
-    * ``"memory"``: in memory, the default;
-    * ``"sqlite://"`` followed by a path: ``sqlite:///var/lib/kb.db`` (absolute),
-      ``sqlite://kb.db`` (relative to the working directory) or ``sqlite://:memory:``;
-    * a MongoDB URI: ``mongodb://host:port/database``;
-    * ``"ros://"`` followed by the knowledge_base node's namespace: ``ros:///merlin2``.
+
+def scheme_of(location: str) -> str:
+    """``"sqlite:///kb.db"`` -> ``"sqlite"``; a location without ``://`` is its own scheme."""
+    scheme, separator, _rest = location.partition(SCHEME_SEPARATOR)
+    return scheme if separator else location
+
+
+def open_store(
+    location: str = MEMORY, timeout: float = DEFAULT_TIMEOUT_SECONDS, stores: PluginTable = STORES
+) -> KnowledgeBase:
+    """Open the store a location names, from ``stores`` (the ROS-free ones by default).
+
+    ``timeout`` bounds the wait for a server, for the stores that have one (MongoDB, ROS).
 
     Raises:
-        ConfigurationError: the location names no known store.
+        ConfigurationError: the location names no known store, or is malformed.
         DependencyError: the store's library is not installed.
         KnowledgeError: the database cannot be opened.
     """
-    if location == MEMORY:
-        from merlin2_sailor.knowledge.memory_store import MemoryStore
-
-        return MemoryStore()
-    if location.startswith(SQLITE_PREFIX):
-        path = location.removeprefix(SQLITE_PREFIX)
-        if not path:
-            raise ConfigurationError(
-                f"{location!r} names no file; write sqlite:///absolute/path.db or sqlite://:memory:"
-            )
-        from merlin2_sailor.knowledge.sqlite_store import SqliteStore
-
-        return SqliteStore(path)
-    if location.startswith(MONGODB_PREFIXES):
-        from merlin2_sailor.knowledge.mongo_store import MongoStore
-
-        return MongoStore(location)
-    if location.startswith(ROS_PREFIX):
-        from merlin2_sailor.ros.knowledge_base_client import RemoteKnowledgeBase
-
-        return RemoteKnowledgeBase(namespace=location.removeprefix(ROS_PREFIX) or "/")
-    raise ConfigurationError(
-        f"unknown knowledge store {location!r}; use 'memory', 'sqlite:///path/to/file.db', "
-        "'mongodb://host:port/database' or 'ros:///namespace'"
-    )
+    scheme = scheme_of(location)
+    if scheme not in stores:
+        raise ConfigurationError(
+            f"unknown knowledge store {location!r} (scheme {scheme!r}; known: {', '.join(stores.names)}); "
+            f"write one of {LOCATION_FORMS}"
+        )
+    store_class: type[KnowledgeBase] = stores.load(scheme)
+    return store_class.from_location(location, timeout=timeout)

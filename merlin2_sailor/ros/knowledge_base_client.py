@@ -1,9 +1,10 @@
 """RemoteKnowledgeBase: the KnowledgeBase port implemented over the knowledge_base node's services.
 
 Components written against :class:`~merlin2_sailor.knowledge.store.KnowledgeBase` use the
-knowledge-base node through this class without knowing it is remote: ``open_store("ros:///merlin2")``
-returns one. It runs its own ROS context, node and executor thread, so its blocking calls can be
-made from anywhere, including another node's callbacks, without deadlocking that node's executor.
+knowledge-base node through this class without knowing it is remote:
+``merlin2_sailor.ros.stores.open_store("ros:///merlin2")`` returns one. It runs its own ROS
+context, node and executor thread, so its blocking calls can be made from anywhere, including
+another node's callbacks, without deadlocking that node's executor.
 
 A knowledge base that does not answer raises KnowledgeError naming the service and the timeout;
 callers log it and try again later, and nothing they hold is lost.
@@ -22,21 +23,22 @@ from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
 from merlin2_sailor.errors import KnowledgeError
 from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind
 from merlin2_sailor.knowledge.model import KnowledgeItem, Proposition
-from merlin2_sailor.knowledge.store import KnowledgeBase, Subscriber, Unsubscribe
+from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS, KnowledgeBase, Subscriber, Unsubscribe
 from merlin2_sailor.ros.background_spinner import BackgroundSpinner
 from merlin2_sailor.ros.conversions import knowledge as convert
-from merlin2_sailor.ros.knowledge_base_node import CHANGES_TOPIC, KIND_SERVICES
+from merlin2_sailor.ros.knowledge_base_services import APPLY_CHANGES_SERVICE, CHANGES_TOPIC, KIND_SERVICES
 from merlin2_sailor.ros.qos import EVENTS
 from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import KnowledgeChanges
 
 DEFAULT_NAMESPACE = "/merlin2"
+SCHEME = "ros://"
 
 
 class RemoteKnowledgeBase(KnowledgeBase):
     """A knowledge base served by a knowledge_base node under ``namespace``."""
 
-    def __init__(self, namespace: str = DEFAULT_NAMESPACE, timeout: float = 5.0) -> None:
+    def __init__(self, namespace: str = DEFAULT_NAMESPACE, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> None:
         super().__init__()
         self._namespace = "/" + namespace.strip("/") if namespace.strip("/") else ""
         self._timeout = timeout
@@ -51,6 +53,11 @@ class RemoteKnowledgeBase(KnowledgeBase):
         self._subscribers: list[Subscriber] = []
         self._subscription: Any = None
         self._closed = False
+
+    @classmethod
+    def from_location(cls, location: str, timeout: float = DEFAULT_TIMEOUT_SECONDS) -> RemoteKnowledgeBase:
+        """``ros:///namespace`` (``ros:///merlin2``); ``ros://`` alone is the root namespace."""
+        return cls(namespace=location.removeprefix(SCHEME) or "/", timeout=timeout)
 
     # Reads.
 
@@ -76,19 +83,13 @@ class RemoteKnowledgeBase(KnowledgeBase):
         request = srv.ApplyChanges.Request(
             changes=[convert.change_to_message(change) for change in changes], writer=self._writer
         )
-        response = self._call(srv.ApplyChanges, "apply_changes", request)
+        response = self._call(srv.ApplyChanges, APPLY_CHANGES_SERVICE, request)
         if not response.success:
             raise KnowledgeError(response.message)
         events = tuple(convert.event_from_message(message) for message in response.events)
         if events:
             self._notify(events)
         return events
-
-    def next_symbol_index(self, class_name: str) -> int:
-        response = self._call(srv.NewSymbol, "new_symbol", srv.NewSymbol.Request(class_name=class_name))
-        if not response.success:
-            raise KnowledgeError(response.message)
-        return int(response.index)
 
     # Events.
 
@@ -173,7 +174,7 @@ class RemoteKnowledgeBase(KnowledgeBase):
             )
         # One retry: right after a knowledge base restarts, the graph may still list the dead
         # process's service, and a request sent to it is lost. Retrying is safe because saves and
-        # deletes are idempotent, and a symbol index lost with a request only leaves a gap.
+        # deletes are idempotent.
         for _attempt in range(2):
             done = threading.Event()
             future = client.call_async(request)

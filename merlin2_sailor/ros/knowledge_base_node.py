@@ -7,15 +7,15 @@ requires. Every batch that changed something is published on ``knowledge_changes
 
 Services (relative names; the node runs under ``/merlin2`` by default, as MERLIN2's KB does):
 ``get_<kinds>``, ``update_<kind>``, ``delete_all_<kinds>`` for types, objects, predicates,
-propositions and actions, plus ``apply_changes`` (a batch in one transaction) and
-``new_symbol`` (the persistent anchor-symbol counter). A refused request is answered with
-``success = false`` and the reason; it never stops the node.
+propositions and actions, plus ``apply_changes`` (a batch in one transaction); their names and
+codecs are in :mod:`~merlin2_sailor.ros.knowledge_base_services`. A refused request is answered
+with ``success = false`` and the reason; it never stops the node. Symbols are not handed out
+here: the anchoring node owns the symbol counter (``anchoring/symbols.py``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from rclpy.node import Node
@@ -24,10 +24,15 @@ from std_msgs.msg import Header
 from merlin2_sailor.errors import KnowledgeError, SailorError
 from merlin2_sailor.knowledge.changes import Change, ChangeEvent, ItemKind
 from merlin2_sailor.knowledge.model import KnowledgeItem
-from merlin2_sailor.knowledge.naming import symbol, to_identifier
 from merlin2_sailor.knowledge.store import KnowledgeBase
 from merlin2_sailor.knowledge.stores import open_store
 from merlin2_sailor.ros.conversions import knowledge as convert
+from merlin2_sailor.ros.knowledge_base_services import (
+    APPLY_CHANGES_SERVICE,
+    CHANGES_TOPIC,
+    KIND_SERVICES,
+    KindServices,
+)
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS
@@ -35,38 +40,9 @@ from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import KnowledgeChanges
 
 NODE_NAME = "knowledge_base"
-CHANGES_TOPIC = "knowledge_changes"
 #: A refusal is answered with its reason every time, but logged at most this often (a client
 #: retrying a bad request in a loop must not flood the log).
 WARNING_PERIOD_SECONDS = 5.0
-
-
-@dataclass(frozen=True)
-class _KindServices:
-    """The service types and message codecs of one kind of item."""
-
-    kind: ItemKind
-    plural: str
-    get_type: Any
-    update_type: Any
-    delete_all_type: Any
-    to_message: Callable[[Any], Any]
-    from_message: Callable[[Any], KnowledgeItem]
-
-
-KIND_SERVICES = (
-    _KindServices(ItemKind.TYPE, "types", srv.GetTypes, srv.UpdateType, srv.DeleteAllTypes,
-                  convert.type_to_message, convert.type_from_message),
-    _KindServices(ItemKind.OBJECT, "objects", srv.GetObjects, srv.UpdateObject, srv.DeleteAllObjects,
-                  convert.object_to_message, convert.object_from_message),
-    _KindServices(ItemKind.PREDICATE, "predicates", srv.GetPredicates, srv.UpdatePredicate,
-                  srv.DeleteAllPredicates, convert.predicate_to_message, convert.predicate_from_message),
-    _KindServices(ItemKind.PROPOSITION, "propositions", srv.GetPropositions, srv.UpdateProposition,
-                  srv.DeleteAllPropositions, convert.proposition_to_message,
-                  convert.proposition_from_message),
-    _KindServices(ItemKind.ACTION, "actions", srv.GetActions, srv.UpdateAction, srv.DeleteAllActions,
-                  convert.action_to_message, convert.action_from_message),
-)
 
 
 class KnowledgeBaseNode(Node):
@@ -74,7 +50,8 @@ class KnowledgeBaseNode(Node):
         super().__init__(NODE_NAME, **node_options)
         location = declare_parameter(
             self, "store", "memory",
-            "Where the knowledge lives: 'memory', 'sqlite:///path/kb.db' or 'mongodb://host:port/db'.",
+            "Where the knowledge lives: 'memory', 'sqlite:///path/kb.db', 'mongodb://host:port/db' "
+            "or 'kant+mongodb://host:port/db' (KANT's DAOs).",
         )
         self._store = store if store is not None else open_store(location)
         self._batch = 0
@@ -83,8 +60,7 @@ class KnowledgeBaseNode(Node):
         self._unsubscribe = self._store.subscribe(self._publish_changes)
         for services in KIND_SERVICES:
             self._serve_kind(services)
-        self.create_service(srv.ApplyChanges, "apply_changes", self._apply_changes)
-        self.create_service(srv.NewSymbol, "new_symbol", self._new_symbol)
+        self.create_service(srv.ApplyChanges, APPLY_CHANGES_SERVICE, self._apply_changes)
         counts = ", ".join(f"{len(self._store.get_all(s.kind))} {s.plural}" for s in KIND_SERVICES)
         self.get_logger().info(f"serving the '{location}' store ({counts})")
 
@@ -107,7 +83,7 @@ class KnowledgeBaseNode(Node):
 
     # Services.
 
-    def _serve_kind(self, services: _KindServices) -> None:
+    def _serve_kind(self, services: KindServices) -> None:
         singular = services.kind.value
         self.create_service(services.get_type, f"get_{services.plural}",
                             lambda request, response: self._get(services, request, response))
@@ -116,7 +92,7 @@ class KnowledgeBaseNode(Node):
         self.create_service(services.delete_all_type, f"delete_all_{services.plural}",
                             lambda request, response: self._delete_all(services, request, response))
 
-    def _get(self, services: _KindServices, request: Any, response: Any) -> Any:
+    def _get(self, services: KindServices, request: Any, response: Any) -> Any:
         items: Sequence[KnowledgeItem]
         if services.kind is ItemKind.PROPOSITION:
             items = (self._store.propositions_about(request.object_name) if request.object_name
@@ -131,7 +107,7 @@ class KnowledgeBaseNode(Node):
         setattr(response, services.plural, [services.to_message(item) for item in items])
         return response
 
-    def _update(self, services: _KindServices, request: Any, response: Any) -> Any:
+    def _update(self, services: KindServices, request: Any, response: Any) -> Any:
         def change() -> list[Change]:
             item = services.from_message(getattr(request, services.kind.value))
             if request.operation == request.OPERATION_SAVE:
@@ -142,7 +118,7 @@ class KnowledgeBaseNode(Node):
 
         return self._write(change, response)
 
-    def _delete_all(self, services: _KindServices, _request: Any, response: Any) -> Any:
+    def _delete_all(self, services: KindServices, _request: Any, response: Any) -> Any:
         return self._write(lambda: [Change.delete(item) for item in self._store.get_all(services.kind)], response)
 
     def _apply_changes(self, request: srv.ApplyChanges.Request,
@@ -155,19 +131,6 @@ class KnowledgeBaseNode(Node):
         finally:
             self._writer = ""
         response.batch = self._batch if self._batch != batch_before else 0
-        return response
-
-    def _new_symbol(self, request: srv.NewSymbol.Request,
-                    response: srv.NewSymbol.Response) -> srv.NewSymbol.Response:
-        try:
-            prefix = to_identifier(request.class_name)
-            response.index = self._store.next_symbol_index(prefix)
-            response.symbol = symbol(prefix, response.index)
-            response.success = True
-        except SailorError as error:
-            response.success, response.message = False, str(error)
-            self.get_logger().error(f"new_symbol for {request.class_name!r} refused: {error}",
-                                    throttle_duration_sec=WARNING_PERIOD_SECONDS)
         return response
 
     def _write(self, make_changes: Callable[[], list[Change]], response: Any,

@@ -122,9 +122,9 @@ def run_observer(arguments: argparse.Namespace) -> dict[str, Any]:
     from rclpy.signals import SignalHandlerOptions
 
     from merlin2_sailor.errors import KnowledgeError
-    from merlin2_sailor.knowledge.stores import open_store
     from merlin2_sailor.ros.conversions import stamp_to_seconds
     from merlin2_sailor.ros.qos import EVENTS, LATCHED
+    from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEvent, AnchorEventArray
 
     stop = StopFlag()

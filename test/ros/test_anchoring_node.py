@@ -23,9 +23,9 @@ from sensor_msgs.msg import CameraInfo
 from std_msgs.msg import Header
 
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
-from merlin2_sailor.knowledge import open_store
 from merlin2_sailor.ros.conversions import camera_info_message, percepts_to_message, seconds_to_stamp
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
+from merlin2_sailor.ros.stores import open_store
 from merlin2_sailor_demos.rgbd_player_node import DEFAULT_CAMERA_POSE
 from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import Anchor, AnchorArray, AnchorEvent, AnchorEventArray, PerceptArray

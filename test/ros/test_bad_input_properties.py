@@ -36,7 +36,6 @@ from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.knowledge import Change, PddlObject, PddlType, Predicate, Proposition
 from merlin2_sailor.knowledge.naming import is_identifier
 from merlin2_sailor.knowledge.pddl_writer import domain_from_store, problem_from_store
-from merlin2_sailor.knowledge.stores import open_store
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.ros.conversions import (
     array_to_image,
@@ -49,6 +48,7 @@ from merlin2_sailor.ros.conversions import (
 )
 from merlin2_sailor.ros.conversions import knowledge as knowledge_messages
 from merlin2_sailor.ros.qos import EVENTS, SENSOR_DATA
+from merlin2_sailor.ros.stores import open_store
 from merlin2_sailor_demos.rgbd_sources import load_source
 from merlin2_sailor_interfaces import msg, srv
 
@@ -498,9 +498,7 @@ def knowledge_requests(draw: st.DrawFn) -> tuple[str, Any, Any]:
     """A hostile request to any knowledge-base service but delete_all_* (which is a valid order)."""
     items = draw(pddl_items())
     operation = draw(st.sampled_from((0, 1, 2, 255)))
-    kind = draw(st.sampled_from(("get", "update", "apply", "new_symbol")))
-    if kind == "new_symbol":
-        return "new_symbol", srv.NewSymbol, srv.NewSymbol.Request(class_name=draw(bad.names))
+    kind = draw(st.sampled_from(("get", "update", "apply")))
     if kind == "apply":
         changes = [msg.KnowledgeChange(operation=draw(st.sampled_from((0, 1, 7))),
                                        kind=draw(st.one_of(st.sampled_from(KINDS), bad.names)), **draw(pddl_items()))

@@ -132,7 +132,8 @@ def wait_until(condition, timeout: float = 20.0) -> bool:  # noqa: ANN001
 
 
 def test_behaviors_register_run_cancel_and_withdraw(node_process, tmp_path: Path) -> None:
-    from merlin2_sailor.knowledge import PddlObject, PddlType, Proposition, Provenance, open_store
+    from merlin2_sailor.knowledge import PddlObject, PddlType, Proposition, Provenance
+    from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_behaviors.actions import REASON_KEY
     from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS
     from merlin2_sailor_behaviors.ros.pddl_action_client import RemoteBehaviours

@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring.state_file import AnchoringStateFile
-from merlin2_sailor.knowledge.stores import open_store
+from merlin2_sailor.ros.stores import open_store
 from merlin2_sailor_interfaces import srv
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # test/ros is not a package: its helpers

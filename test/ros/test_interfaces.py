@@ -20,7 +20,7 @@ def test_the_interfaces_cover_detections_percepts_anchors_and_the_knowledge_base
     names = {message_type.__name__ for message_type in MESSAGE_TYPES + SERVICE_TYPES}
     assert {"Detection", "DetectionArray", "Percept", "PerceptArray", "Anchor", "AnchorArray",
             "GetAnchors", "FindAnchor", "ForgetAnchor", "PddlProposition", "KnowledgeChanges",
-            "ApplyChanges", "NewSymbol", "GetPropositions", "UpdateProposition",
+            "ApplyChanges", "GetPropositions", "UpdateProposition",
             "DeleteAllPropositions"} <= names
 
 

@@ -290,16 +290,6 @@ def test_symbols_come_from_the_given_factory(maker, kitchen):
     assert result.percept_symbols == ("cup_101", "bowl_102", "apple_103")
 
 
-def test_symbols_from_a_knowledge_base_counter(maker, kitchen):
-    from merlin2_sailor.knowledge import open_store
-
-    with open_store() as knowledge_base:
-        anchoring = Anchoring(symbol_factory=knowledge_base.new_symbol)
-        result = anchoring.process([maker.percept(kitchen["red_cup"], 0.0)], None, 0.0)
-        assert result.percept_symbols == ("cup_1",)
-        assert knowledge_base.new_symbol("cup") == "cup_2"
-
-
 def test_a_factory_reusing_a_symbol_is_a_clear_error(maker, kitchen):
     anchoring = Anchoring(symbol_factory=lambda class_name: "thing_1")
     far_cup = SceneObject("far_cup", "cup", (9.0, 9.0, 0.8))

@@ -28,8 +28,8 @@ from merlin2_sailor.knowledge import (
     PddlType,
     Predicate,
     Proposition,
-    open_store,
 )
+from merlin2_sailor.ros.stores import open_store
 
 SERVER_START_TIMEOUT_SECONDS = 15.0
 

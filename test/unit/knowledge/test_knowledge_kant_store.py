@@ -92,10 +92,6 @@ def test_provenance_is_kept_for_own_facts_and_foreign_facts_read_as_declared(sto
         ("object_at", ("cup_1", "kitchen"), False)).provenance is Provenance.DECLARED
 
 
-def test_symbols_follow_kants_objects_and_never_repeat_within_a_run(store, kant) -> None:
-    kant.objects.save(PddlObjectDto(PddlTypeDto("cup"), "cup_7"))
-    assert [store.new_symbol("cup"), store.new_symbol("cup")] == ["cup_8", "cup_9"]
-    assert store.new_symbol("dining table") == "dining_table_1"
 
 
 def test_a_refusal_from_kant_is_a_knowledge_error(store, kant) -> None:

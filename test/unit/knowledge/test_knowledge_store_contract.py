@@ -1,4 +1,4 @@
-"""The contract every store keeps, run against memory, SQLite and MongoDB alike."""
+"""The contract every store keeps, run against memory, SQLite, MongoDB and the ROS client alike."""
 
 import pytest
 
@@ -17,8 +17,8 @@ from merlin2_sailor.knowledge import (
     Predicate,
     Proposition,
     Provenance,
-    open_store,
 )
+from merlin2_sailor.ros.stores import open_store
 
 
 def saved(kind: ItemKind, item) -> ChangeEvent:
@@ -295,17 +295,6 @@ class TestEvents:
         assert len(heard) == 1
 
 
-class TestSymbols:
-    def test_indices_count_up_per_class(self, store):
-        assert [store.next_symbol_index("cup") for _ in range(3)] == [1, 2, 3]
-        assert store.next_symbol_index("bottle") == 1
-        assert store.new_symbol("cup") == "cup_4"
-
-    def test_spellings_of_one_class_share_a_counter(self, store):
-        assert store.new_symbol("dining table") == "dining_table_1"
-        assert store.new_symbol("Dining-Table") == "dining_table_2"
-
-
 class TestPersistence:
     def test_items_survive_reopening(self, persistent_location, scene):
         with open_store(persistent_location) as store:
@@ -317,15 +306,6 @@ class TestPersistence:
             assert store.propositions_about("cup_1") == (
                 Proposition("object_at", ("cup_1", "kitchen")),
             )
-
-    def test_symbol_indices_are_never_reused_after_reopening(self, persistent_location):
-        with open_store(persistent_location) as store:
-            first = [store.new_symbol("cup") for _ in range(3)]
-            store.objects.save(PddlObject(first[-1], "cup"))
-            store.objects.delete(first[-1])
-        with open_store(persistent_location) as store:
-            assert store.new_symbol("cup") == "cup_4"
-            assert store.new_symbol("bottle") == "bottle_1"
 
     def test_updates_and_cascades_are_persisted(self, persistent_location, scene):
         with open_store(persistent_location) as store:
