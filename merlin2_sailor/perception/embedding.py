@@ -21,12 +21,13 @@ import cv2
 import numpy as np
 
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.perception.backbone import Backbone, create_backbone
+from merlin2_sailor.perception.backbone import Backbone
+from merlin2_sailor.perception.backbone_registry import create_backbone
 
 
 @dataclass(frozen=True, slots=True)
 class EmbeddingConfig:
-    """``backbone``: a name from :data:`~.backbone.BACKBONES`; ``weights_path``: its weights file,
+    """``backbone``: a name from :data:`~.backbone_registry.BACKBONES`; ``weights_path``: its weights file,
     when it has none bundled; ``batch_size``: crops per forward pass (4 suits a CPU, see above)."""
 
     backbone: str = "efficientnet_lite0"

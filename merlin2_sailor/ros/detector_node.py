@@ -28,7 +28,8 @@ from sensor_msgs.msg import Image
 
 from merlin2_sailor.diagnostics.topic_statistics import TopicStatistics
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
-from merlin2_sailor.perception.detector import DETECTOR_BACKENDS, Detector, create_detector
+from merlin2_sailor.perception.detector import Detector
+from merlin2_sailor.perception.detector_registry import DETECTOR_BACKENDS, create_detector
 from merlin2_sailor.ros.conversions import (
     detection_from_message,
     detections_to_message,

@@ -13,7 +13,8 @@ from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidIn
 from merlin2_sailor.perception.box_overlap import intersection_over_union, suppress_cross_class_duplicates
 from merlin2_sailor.perception.coco_labels import COCO_TF_LABELS, coco_tf_label
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.detector import Detector, check_rgb_image, create_detector
+from merlin2_sailor.perception.detector import Detector, check_rgb_image
+from merlin2_sailor.perception.detector_registry import create_detector
 
 from .scenes import DARKNET_DATA, load_darknet_image
 

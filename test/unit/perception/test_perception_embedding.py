@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidInputError
-from merlin2_sailor.perception.backbone import create_backbone
+from merlin2_sailor.perception.backbone_registry import create_backbone
 
 from .scenes import load_darknet_image
 
