@@ -5,7 +5,7 @@ Steps: generate the train and validation scenes (lazily, from the seed), embed e
 class-balanced training pairs, validate on every validation pair each epoch, keep the best epoch.
 Writes the weights (with their metadata header), a ``.json`` provenance file beside them and a
 loss-curve PNG. Uses CUDA when available (``--device``). ``--source`` trains on a public data set
-instead (nuScenes or MOTFront, read by :mod:`merlin2_sailor.training.external_source`); its
+instead (nuScenes or MOTFront, chosen in :mod:`merlin2_sailor.training.source_registry`); its
 scenes are split by scene and the scene counts are capped at what each split holds.
 """
 
@@ -16,9 +16,10 @@ import time
 from dataclasses import asdict
 from pathlib import Path
 
+from merlin2_sailor.training.source_registry import SOURCE_FORMS
+
 DEFAULT_OUTPUT = "matching_network.pt"
-SOURCE_HELP = ("pairs from: generated (default), nuscenes:DATAROOT[:VERSION] (nuScenes' JSON tables, "
-               "e.g. nuscenes:/data/nuscenes:v1.0-mini) or motfront:ROOT")
+SOURCE_HELP = f"pairs from: generated (default), {SOURCE_FORMS}"
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -123,7 +124,7 @@ def pair_source(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
     """The source ``--source`` names: the generated one, or a public data set's adapter."""
     if arguments.source == "generated":
         return generated_source(arguments)
-    from merlin2_sailor.training.external_source import open_source
+    from merlin2_sailor.training.source_registry import open_source
 
     return open_source(arguments.source)
 

@@ -11,7 +11,8 @@ nothing (the real camera already did) and only gives the crop's size, ``twin`` i
 An :class:`ImageSource` answers the same two calls as the generated source,
 ``scenes(split, count, first)`` and ``render(observation)``, plus ``split_size(split)`` (a
 public set has a finite number of scenes), so :class:`~.generated_dataset.GeneratedPairSet`
-and the training and evaluation commands drive either kind.
+and the training and evaluation commands drive either kind. The sources are chosen by name in
+:mod:`.source_registry`, the table above them.
 """
 
 from __future__ import annotations
@@ -160,6 +161,11 @@ class ImageSource(ABC):
     def split_scene_names(self) -> Mapping[str, Sequence[str]]:
         """Scene names of each split in :data:`SPLITS` (disjoint)."""
 
+    @classmethod
+    def from_specification(cls, specification: str) -> ImageSource:
+        """The source a ``--source`` value names, given what follows ``name:`` (see the registry)."""
+        raise NotImplementedError(f"{cls.__name__} is not opened from a --source value; construct it")
+
     @abstractmethod
     def load_scene(self, name: str, split: str, index: int) -> Scene:
         """One scene, read from the data set's files."""
@@ -191,24 +197,3 @@ def file_stamp(path: Path) -> str:
     """Size and modification time of a file, for fingerprints (a changed table changes crop ids)."""
     status = path.stat()
     return f"{path.name}:{status.st_size}:{status.st_mtime_ns}"
-
-
-def open_source(specification: str) -> ImageSource:
-    """The source named by a ``--source`` value: ``nuscenes:DATAROOT[:VERSION]`` or ``motfront:ROOT``."""
-    kind, _, rest = specification.partition(":")
-    if kind == "nuscenes" and rest:
-        from merlin2_sailor.training.nuscenes_source import NuScenesConfig, NuScenesSource
-
-        dataroot, version = rest, ""
-        head, _, tail = rest.rpartition(":")
-        if head and tail and "/" not in tail:
-            dataroot, version = head, tail
-        return NuScenesSource(NuScenesConfig(dataroot=dataroot, version=version))
-    if kind == "motfront" and rest:
-        from merlin2_sailor.training.motfront_source import MotFrontConfig, MotFrontSource
-
-        return MotFrontSource(MotFrontConfig(root=rest))
-    raise ConfigurationError(
-        f"Unknown data source {specification!r}: use generated, nuscenes:DATAROOT[:VERSION] "
-        "(e.g. nuscenes:/data/nuscenes:v1.0-mini) or motfront:ROOT."
-    )

@@ -93,6 +93,11 @@ class MotFrontSource(ImageSource):
 
     name = "motfront"
 
+    @classmethod
+    def from_specification(cls, specification: str) -> MotFrontSource:
+        """``ROOT``: the data set folder."""
+        return cls(MotFrontConfig(root=specification))
+
     def __init__(self, config: MotFrontConfig) -> None:
         self.config = config
         self.root = Path(config.root).expanduser()

@@ -131,6 +131,15 @@ class NuScenesSource(ImageSource):
 
     name = "nuscenes"
 
+    @classmethod
+    def from_specification(cls, specification: str) -> NuScenesSource:
+        """``DATAROOT[:VERSION]``: a last part without ``/`` is the version (``/data/nuscenes:v1.0-mini``)."""
+        dataroot, version = specification, ""
+        head, _, tail = specification.rpartition(":")
+        if head and tail and "/" not in tail:
+            dataroot, version = head, tail
+        return cls(NuScenesConfig(dataroot=dataroot, version=version))
+
     def __init__(self, config: NuScenesConfig) -> None:
         self.config = config
         self.root = Path(config.dataroot).expanduser()

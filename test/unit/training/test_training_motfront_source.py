@@ -19,9 +19,10 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.errors import DependencyError, InvalidInputError
-from merlin2_sailor.training.external_source import ALL, open_source
+from merlin2_sailor.training.external_source import ALL
 from merlin2_sailor.training.motfront_source import MotFrontConfig, MotFrontSource
 from merlin2_sailor.training.pair_dataset import PairChunk, PairDatasetConfig, iter_pair_chunks
+from merlin2_sailor.training.source_registry import open_source
 
 WIDTH, HEIGHT = 320, 240
 

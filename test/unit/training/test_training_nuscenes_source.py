@@ -18,9 +18,10 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.errors import ConfigurationError, DependencyError
-from merlin2_sailor.training.external_source import ALL, ImageObservation, open_source
+from merlin2_sailor.training.external_source import ALL, ImageObservation
 from merlin2_sailor.training.nuscenes_source import NuScenesConfig, NuScenesSource, short_class
 from merlin2_sailor.training.pair_dataset import PairChunk, PairDatasetConfig, iter_pair_chunks
+from merlin2_sailor.training.source_registry import open_source
 
 VERSION = "v1.0-mini"
 WIDTH, HEIGHT, FOCAL = 400, 300, 300.0
