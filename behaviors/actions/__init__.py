@@ -4,7 +4,7 @@ ROS-free. :class:`SailorAction` (the pair, with knowledge-base registration),
 :mod:`.domain` (SAILOR's PDDL domain, as data), the ports behaviours talk to the robot through
 (:mod:`.clients`), the map's places (:mod:`.places`), the context a state machine is built with
 (:mod:`.context`) and the states behaviours are assembled from (:mod:`.states`). Every action by
-name is in :mod:`.catalogue`, imported on its own because it imports every behaviour.
+name is in :mod:`merlin2_sailor_behaviors.catalogue`, one level above the behaviours it lists.
 """
 
 from merlin2_sailor_behaviors.actions.clients import (

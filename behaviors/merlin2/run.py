@@ -13,7 +13,7 @@ import sys
 from collections.abc import Sequence
 
 from merlin2_sailor.errors import SailorError
-from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS, select_actions
+from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
 
 
 def main(argv: Sequence[str] | None = None) -> int:

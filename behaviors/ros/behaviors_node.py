@@ -36,13 +36,13 @@ from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.stores import open_store
-from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.actions.context import BehaviorConfig, BehaviorContext
 from merlin2_sailor_behaviors.actions.domain import LOCATION_TYPE
 from merlin2_sailor_behaviors.actions.errors import BehaviorError
 from merlin2_sailor_behaviors.actions.places import Places
 from merlin2_sailor_behaviors.actions.robot_location import declare_robot_at, robot_locations
 from merlin2_sailor_behaviors.actions.sailor_action import SailorAction
+from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.ros.anchoring_client import RosAnchoringClient
 from merlin2_sailor_behaviors.ros.grasp_client import RosGraspClient
 from merlin2_sailor_behaviors.ros.navigation_client import RosNavigationClient

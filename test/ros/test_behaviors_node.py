@@ -135,7 +135,7 @@ def test_behaviors_register_run_cancel_and_withdraw(node_process, tmp_path: Path
     from merlin2_sailor.knowledge import PddlObject, PddlType, Proposition, Provenance
     from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_behaviors.actions import REASON_KEY
-    from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS
+    from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS
     from merlin2_sailor_behaviors.ros.pddl_action_client import RemoteBehaviours
     from merlin2_sailor_behaviors.state_machines import ABORT, CANCEL, SUCCEED
     from merlin2_sailor_interfaces.msg import Anchor

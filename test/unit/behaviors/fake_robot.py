@@ -35,7 +35,7 @@ from merlin2_sailor_behaviors.actions import (
     Places,
     Pose2D,
 )
-from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS
+from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS
 
 WAYPOINTS = {"a": (0.0, 0.0), "b": (2.0, 0.0), "c": (5.0, 0.0), "d": (2.0, 3.0)}
 

@@ -18,8 +18,8 @@ from merlin2_sailor.knowledge import (
     open_store,
 )
 from merlin2_sailor_behaviors.actions import PLAN_STEP_KEY, SailorAction, active_state_path
-from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.actions.domain import ACTIONS, PREDICATES
+from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.planning import PlanStep
 from merlin2_sailor_behaviors.state_machines import SUCCEED, CbState, StateMachine
 

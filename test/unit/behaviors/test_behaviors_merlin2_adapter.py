@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import pytest
 
 from merlin2_sailor.errors import DependencyError
-from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS
+from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS
 from merlin2_sailor_behaviors.state_machines import ABORT, CANCEL, SUCCEED, Blackboard, StateMachine
 
 from .fake_robot import FakeRobot, make_robot

@@ -13,8 +13,8 @@ from merlin2_sailor.anchoring.anchor import AnchorState
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.knowledge import GroundingConfig, PddlObject, Proposition, Provenance
 from merlin2_sailor_behaviors.actions import BehaviorConfig, BehaviorError, Place, Places, Pose2D
-from merlin2_sailor_behaviors.actions.catalogue import SAILOR_ACTIONS
 from merlin2_sailor_behaviors.actions.robot_location import declare_robot_at, objects_at, robot_locations
+from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS
 
 from .fake_robot import FakeRobot, make_robot
 

@@ -1,7 +1,9 @@
 """Every SAILOR action by name: what the ``behaviors`` node serves and MERLIN2 adapters register.
 
-Kept apart from :mod:`merlin2_sailor_behaviors.actions` (which the behaviour modules import), so
-that importing the base never imports every behaviour.
+One level above the behaviour packages (navigation, find_object, manipulation), which build on
+the action base in :mod:`merlin2_sailor_behaviors.actions`: the catalogue imports them, they
+import the base, and the base imports no behaviour. A new action is a behaviour module defining
+its ``SailorAction`` plus one name in the tuple below.
 """
 
 from __future__ import annotations
