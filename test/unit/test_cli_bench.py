@@ -1,29 +1,47 @@
-"""``sailor bench``: one fast benchmark end to end into a report folder, and the report's parts."""
+"""``sailor bench``: one fast benchmark end to end into a report folder, and the report's parts.
+
+The command runs the checkout's bench/suite.py in a process of its own (the package never imports
+bench/), so its output is read at the file descriptors (``capfd``); the suite's own behaviour
+(a failing benchmark) is tested by loading the suite as bench's scripts do, with bench/ on the path.
+"""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import sys
 from pathlib import Path
+from types import ModuleType
 
 import cv2
 import pytest
 
-from merlin2_sailor.cli.bench import BENCHMARKS, bench_directory
+from merlin2_sailor.cli.bench import bench_directory
 from merlin2_sailor.cli.main import main
+from merlin2_sailor.errors import ConfigurationError
 
 REPOSITORY_ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture
+def suite(monkeypatch: pytest.MonkeyPatch) -> ModuleType:
+    """bench/suite.py as a module, imported the way a script of bench/ is run: bench/ on the path."""
+    monkeypatch.syspath_prepend(str(REPOSITORY_ROOT / "bench"))
+    spec = importlib.util.spec_from_file_location("sailor_bench_suite", REPOSITORY_ROOT / "bench" / "suite.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def figures_of(document: dict) -> list[dict]:
     return [figure for run in document["benchmarks"].values() for figure in run["result"]["figures"]]
 
 
-def test_quick_run_of_one_benchmark_writes_report_json_and_plots(tmp_path, capsys) -> None:
+def test_quick_run_of_one_benchmark_writes_report_json_and_plots(tmp_path, capfd) -> None:
     output = tmp_path / "report"
     assert main(["bench", "--quick", "--only", "assignment", "--output", str(output)]) == 0
-    console = capsys.readouterr().out
+    console = capfd.readouterr().out
     assert "[1/1] assignment" in console and "done in" in console and "wrote" in console
 
     document = json.loads((output / "results.json").read_text())
@@ -46,35 +64,52 @@ def test_quick_run_of_one_benchmark_writes_report_json_and_plots(tmp_path, capsy
     assert "](plots/assignment.png)" in report
 
 
-def test_an_unknown_benchmark_is_refused(capsys) -> None:
-    with pytest.raises(SystemExit) as exit_info:
-        main(["bench", "--only", "nonsense"])
-    assert exit_info.value.code == 2
-    assert "invalid choice" in capsys.readouterr().err
+def test_an_unknown_benchmark_is_refused(capfd) -> None:
+    assert main(["bench", "--only", "nonsense"]) == 2
+    assert "invalid choice: 'nonsense'" in capfd.readouterr().err
 
 
-def test_every_listed_benchmark_is_a_script_of_bench() -> None:
+def test_help_is_the_suites_and_lists_every_benchmark(capfd, suite) -> None:
+    assert main(["bench", "--help"]) == 0
+    shown = capfd.readouterr().out
+    assert shown.startswith("usage: sailor bench")
+    assert all(name in shown for name in suite.BENCHMARKS)
+
+
+def test_every_listed_benchmark_is_a_script_of_bench(suite) -> None:
     folder = bench_directory()
-    assert folder.resolve() == (REPOSITORY_ROOT / "bench").resolve()
-    for script, _ in BENCHMARKS.values():
+    assert folder.resolve() == (REPOSITORY_ROOT / "bench").resolve() == suite.BENCH_FOLDER
+    for script, _ in suite.BENCHMARKS.values():
         assert (folder / script).is_file(), script
 
 
-def test_a_failing_benchmark_is_reported_and_the_others_still_run(tmp_path, monkeypatch, capsys) -> None:
+def test_without_a_checkout_the_command_says_where_the_suite_is(tmp_path, monkeypatch, capsys) -> None:
     import merlin2_sailor.cli.bench as bench
 
+    def no_share_directory() -> Path:
+        raise ConfigurationError("no share folder")
+
+    monkeypatch.setattr(bench, "share_directory", no_share_directory)
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ConfigurationError, match="source checkout"):
+        bench_directory()
+    assert main(["bench", "--quick"]) == 2
+    assert "not installed with the package" in capsys.readouterr().err
+
+
+def test_a_failing_benchmark_is_reported_and_the_others_still_run(tmp_path, monkeypatch, capsys, suite) -> None:
     broken = tmp_path / "bench_broken.py"
     broken.write_text("raise SystemExit('this benchmark is broken')\n")
-    real_command = bench.benchmark_command
+    real_command = suite.benchmark_command
 
     def command(folder, name, arguments, json_file, output):
         if name == "knowledge_sync":
             return [sys.executable, str(broken)]
         return real_command(folder, name, arguments, json_file, output)
 
-    monkeypatch.setattr(bench, "benchmark_command", command)
+    monkeypatch.setattr(suite, "benchmark_command", command)
     output = tmp_path / "report"
-    assert main(["bench", "--quick", "--only", "knowledge_sync", "assignment", "--output", str(output)]) == 1
+    assert suite.main(["--quick", "--only", "knowledge_sync", "assignment", "--output", str(output)]) == 1
     document = json.loads((output / "results.json").read_text())
     assert document["benchmarks"]["knowledge_sync"]["status"] == "failed"
     assert "this benchmark is broken" in document["benchmarks"]["knowledge_sync"]["error"]
