@@ -119,3 +119,55 @@ def test_a_layer_above_extends_a_table_without_changing_it(plugin_package: str) 
         above.load("heavy")
     with pytest.raises(ValueError, match="taken"):
         below.extended({"light": f"{plugin_package}.light:Greeter"})
+
+
+def shipped_tables() -> dict[str, PluginTable]:
+    """Every PluginTable the three packages define at module level, found by reading their source."""
+    import ast
+    import importlib
+
+    roots = {"merlin2_sailor": "merlin2_sailor", "merlin2_sailor_behaviors": "behaviors",
+             "merlin2_sailor_demos": "demos"}
+    repository = Path(__file__).resolve().parents[2]
+    tables = {}
+    for package, folder in roots.items():
+        for path in sorted((repository / folder).rglob("*.py")):
+            text = path.read_text(encoding="utf-8")
+            if "PluginTable(" not in text and ".extended(" not in text or path.name == "plugins.py":
+                continue
+            tree = ast.parse(text)
+            names = [target.id for node in tree.body if isinstance(node, ast.Assign | ast.AnnAssign)
+                     for target in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                     if isinstance(target, ast.Name)]
+            parts = path.relative_to(repository / folder).with_suffix("").parts
+            module = importlib.import_module(".".join([package, *parts]))
+            tables.update({f"{module.__name__}.{name}": getattr(module, name) for name in names
+                           if isinstance(getattr(module, name, None), PluginTable)})
+    return tables
+
+
+def defines(module_name: str, attribute: str) -> bool:
+    """Whether the module's source defines ``attribute`` at top level (read, not imported)."""
+    import ast
+    import importlib.util
+
+    spec = importlib.util.find_spec(module_name)
+    assert spec is not None and spec.origin, f"no module {module_name}"
+    tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
+    for node in tree.body:
+        if isinstance(node, ast.ClassDef | ast.FunctionDef) and node.name == attribute:
+            return True
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == attribute for t in node.targets):
+            return True
+    return False
+
+
+def test_every_shipped_table_names_modules_and_attributes_that_exist() -> None:
+    """Read, not imported: a typo in any table fails here, without torch, KANT or ROS installed."""
+    tables = shipped_tables()
+    kinds = {table.kind for table in tables.values()}
+    assert {"knowledge store", "detector backend", "backbone", "data source"} <= kinds, kinds
+    for where, table in tables.items():
+        for name, target in table.entries.items():
+            module_name, _, attribute = target.partition(":")
+            assert defines(module_name, attribute), f"{where}[{name!r}] -> {target} does not exist"
