@@ -1,8 +1,9 @@
 """AnchorView: an immutable copy of what other threads may read of an anchor.
 
 The anchoring core mutates anchors in place on every frame. The knowledge-base sync and the
-state file run off the perception hot path, in another thread, so they get frozen copies taken
-under the node's lock, never the live anchors. A view satisfies the grounding protocols
+state file run off the perception hot path, in another thread, and the node publishes anchors and
+answers services from other threads than the one anchoring frames; so they all get frozen copies
+taken under the service's lock, never the live anchors. A view satisfies the grounding protocols
 (``GroundableAnchor`` and ``SizedAnchor``).
 """
 
@@ -18,18 +19,29 @@ from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 
 @dataclass(frozen=True, eq=False)
 class AnchorView:
+    """What an anchor was at one instant: enough for grounding, the knowledge-base sync, the
+    state published to other nodes (messages, markers) and service answers."""
+
     symbol: str
     class_name: str
     position: np.ndarray
     size: np.ndarray
     state: AnchorState
     visible: bool
+    confidence: float
+    times_seen: int
+    last_tracker_id: str
+    first_seen: float
+    last_seen: float
+    indistinguishable_from: tuple[str, ...] = ()
 
     @classmethod
     def of(cls, anchor: Anchor) -> AnchorView:
         position, size = anchor.position.copy(), anchor.size.copy()
         position.flags.writeable = size.flags.writeable = False
-        return cls(anchor.symbol, anchor.class_name, position, size, anchor.state, anchor.visible)
+        return cls(anchor.symbol, anchor.class_name, position, size, anchor.state, anchor.visible,
+                   anchor.confidence, anchor.times_seen, anchor.last_tracker_id, anchor.first_seen,
+                   anchor.last_seen, anchor.indistinguishable_from)
 
 
 def views_of(anchors: Iterable[Anchor]) -> list[AnchorView]:

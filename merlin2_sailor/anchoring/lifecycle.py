@@ -31,7 +31,7 @@ class LifecycleConfig:
 
     confirm_after: int = 3
     missed_frames_to_missing: int = 3
-    forget_after: float = 60.0
+    forget_after: float = 600.0
     forget_tentative_after: float = 2.0
 
     def __post_init__(self) -> None:

@@ -1,11 +1,14 @@
 """anchoring: SAILOR's anchoring layer as a node: percepts in, anchors, events and facts out.
 
-For every PerceptArray it runs acquire / reacquire (the matching table, then Hungarian) in the
-ROS-free :class:`~merlin2_sailor.anchoring.Anchoring`, with the camera's pose, intrinsics and depth
-at the percepts' stamp, so anchors that should have been visible but were not become missing.
-A timer runs Track (expected effects, carried objects, forgetting). Off the hot path, a worker
+The anchoring layer itself is the ROS-free :class:`~merlin2_sailor.anchoring.service.AnchoringService`
+(the core, the symbol counter and state file, the persistence worker, the matcher), built from the
+parameters of :data:`~merlin2_sailor.anchoring.settings.SETTINGS` exactly as ``sailor replay``
+builds it from the same parameter files. For every PerceptArray the core runs acquire / reacquire
+(the matching table, then Hungarian) with the camera's pose, intrinsics and depth at the
+percepts' stamp, so anchors that should have been visible but were not become missing. A timer
+runs Track (expected effects, carried objects, forgetting). Off the hot path, the service's worker
 thread syncs the anchors into the knowledge base by diff and saves them to disk, so they survive
-a restart with the same symbols.
+a restart with the same symbols. Messages are built from frozen views of the anchors.
 
 Topics: in ``percepts``, ``color/camera_info``, ``camera_pose``, ``depth/image_raw`` (optional,
 for occlusion), ``robot_pose`` (for carried objects); out ``anchors`` (latched, on change),
@@ -15,7 +18,6 @@ for occlusion), ``robot_pose`` (for carried objects); out ``anchors`` (latched, 
 
 from __future__ import annotations
 
-import dataclasses
 import threading
 from collections.abc import Sequence
 from typing import Any
@@ -27,24 +29,18 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.anchor_view import views_of
-from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringConfig, AnchoringResult
+from merlin2_sailor.anchoring.anchor import AnchorState
+from merlin2_sailor.anchoring.anchor_view import AnchorView
+from merlin2_sailor.anchoring.anchoring import AnchoringResult
 from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
-from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
-from merlin2_sailor.anchoring.persistence_worker import AnchorsCopy, PersistenceWorker
-from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
-from merlin2_sailor.anchoring.state_file import AnchoringStateFile
-from merlin2_sailor.anchoring.symbols import SymbolCounter
-from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig
+from merlin2_sailor.anchoring.service import AnchoringService
+from merlin2_sailor.anchoring.settings import SETTINGS, AnchoringSettings, settings_from_parameters
+from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
-from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig
-from merlin2_sailor.knowledge.stores import ROS_PREFIX, open_store
 from merlin2_sailor.perception.stamped_buffer import StampedBuffer
-from merlin2_sailor.resources import config_path
 from merlin2_sailor.ros.conversions import (
     camera_info_to_intrinsics,
     depth_to_metres,
@@ -58,6 +54,7 @@ from merlin2_sailor.ros.newest_frame_mailbox import NewestFrameMailbox
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
+from merlin2_sailor.ros.stores import open_store
 from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
 
@@ -69,76 +66,38 @@ FUTURE_STAMP_LIMIT_SECONDS = 10.0
 DROP_REPORT_PERIOD_SECONDS = 5.0
 
 
+def declare_settings(node: Node) -> AnchoringSettings:
+    """Declare every anchoring parameter of :data:`~merlin2_sailor.anchoring.settings.SETTINGS` with
+    its descriptor, and build the settings from their values as ``sailor replay`` builds them from
+    the same files (:func:`~merlin2_sailor.anchoring.settings.settings_from_parameters`)."""
+    values = {
+        row.name: declare_parameter(
+            node, row.name, row.default,
+            row.description + (f" One of: {', '.join(row.choices)}." if row.choices else ""),
+            minimum=row.minimum, maximum=row.maximum)
+        for row in SETTINGS
+    }
+    source = f"the parameters of node {node.get_fully_qualified_name()}"
+    return settings_from_parameters(values, dict.fromkeys(values, source))
+
+
 class AnchoringNode(Node):
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        world_frame = declare_parameter(self, "world_frame", "map", "Fixed frame the anchors live in.")
-        matcher = declare_parameter(
-            self, "matcher", "rules",
-            "Matching function: 'rules' (class, distance, time) or 'network' (the learned one).")
-        weights = declare_parameter(
-            self, "weights", "", "Matching network weights (matcher 'network'); '' uses the shipped ones.")
-        backbone = declare_parameter(
-            self, "backbone", "efficientnet_lite0", "Crop backbone the network was trained with.")
-        knowledge_base = declare_parameter(
-            self, "knowledge_base", "ros:///merlin2",
-            "Knowledge base the anchors are synced into ('' for none): ros:///namespace, "
-            "sqlite:///path, mongodb://host/db or memory.")
-        grounding_file = declare_parameter(
-            self, "grounding", "", "Grounding YAML (class -> type, map); empty: config/grounding.yaml.")
-        state_folder = declare_parameter(
-            self, "state_folder", "~/.sailor/anchoring",
-            "Folder where anchors and symbol counters are saved ('' to start afresh every time).")
-        sync_period = declare_parameter(
-            self, "sync_period", 0.5, "Seconds between knowledge-base syncs.", minimum=0.05, maximum=60.0)
-        save_period = declare_parameter(
-            self, "save_period", 2.0, "Seconds between saves of the anchors.", minimum=0.1, maximum=3600.0)
-        track_period = declare_parameter(
-            self, "track_period", 0.5, "Seconds between Track steps.", minimum=0.05, maximum=60.0)
-        forget_after = declare_parameter(
-            self, "forget_after", 600.0,
-            "Seconds a confirmed anchor may stay missing before it is forgotten (and leaves the KB).",
-            minimum=0.0, maximum=1e9)
-        forget_tentative_after = declare_parameter(
-            self, "forget_tentative_after", 2.0,
-            "Seconds a never-confirmed anchor (often a false detection) survives not being seen where it should be.",
-            minimum=0.0, maximum=3600.0)
-        default_visibility = VisibilityConfig()
-        visible_range = declare_parameter(
-            self, "visible_range", default_visibility.frustum.far,
-            "Farthest an anchor may be (m) and still be expected in view; keep it within the percept "
-            "generator's maximum_depth, or anchors beyond it are marked missing for not being perceived.",
-            minimum=0.3, maximum=100.0)
-        stamp_tolerance = declare_parameter(
-            self, "stamp_tolerance", 0.05,
-            "Largest gap (s) between percepts and the camera pose / depth they are judged with.",
-            minimum=0.0, maximum=1.0)
-
-        self._lock = threading.Lock()  # the core is single-threaded; the worker reads under this
-        self._state_file = AnchoringStateFile(state_folder) if state_folder else None
-        saved = self._state_file.load() if self._state_file else None
-        self._symbols = SymbolCounter(saved.symbol_indices if saved else None)
-        if saved and saved.owned_objects:
-            self._symbols.note_used(saved.owned_objects)  # symbols the knowledge base has seen
-        self._anchoring = Anchoring(
-            AnchoringConfig(
-                world_frame=world_frame,
-                lifecycle=LifecycleConfig(forget_after=forget_after, forget_tentative_after=forget_tentative_after),
-                visibility=dataclasses.replace(
-                    default_visibility, frustum=dataclasses.replace(default_visibility.frustum, far=visible_range)),
-            ),
-            matcher=self._make_matcher(matcher, weights, backbone),
-            # The network compares crops, so it needs them embedded; the rules never look at them.
-            embedder=self._make_embedder(backbone) if matcher == "network" else None,
-            symbol_factory=self._new_symbol,
-        )
-        if saved and saved.snapshot:
-            self._anchoring.restore(saved.snapshot)
-            self.get_logger().info(f"restored {len(self._anchoring)} anchors from {state_folder}")
-        self._world_frame = world_frame
+        settings = declare_settings(self)
+        self.service = AnchoringService(settings, log=self._log, open_knowledge_base=open_store)
+        # The core is single-threaded: the frame thread, the executor's callbacks and the
+        # persistence worker take this lock around it, and read anchors as views taken under it.
+        self._lock = self.service.lock
+        self._anchoring = self.service.anchoring
+        if self.service.restored:
+            self.get_logger().info(
+                f"restored {self.service.restored} anchors from {settings.persistence.state_folder}")
+        self._world_frame = settings.core.world_frame
         self._intrinsics: CameraIntrinsics | None = None
-        self._poses: StampedBuffer[Pose] = StampedBuffer(tolerance=stamp_tolerance)
-        self._depths: StampedBuffer[np.ndarray] = StampedBuffer(capacity=5, tolerance=stamp_tolerance)
+        tolerance = settings.timing.stamp_tolerance
+        self._poses: StampedBuffer[Pose] = StampedBuffer(tolerance=tolerance)
+        self._depths: StampedBuffer[np.ndarray] = StampedBuffer(capacity=5, tolerance=tolerance)
         self._robot_pose: Pose | None = None
 
         self._anchors_publisher = self.create_publisher(AnchorArray, "anchors", LATCHED)
@@ -153,7 +112,7 @@ class AnchoringNode(Node):
         self.create_service(srv.FindAnchor, "~/find_anchor", self._find_anchor)
         self.create_service(srv.ForgetAnchor, "~/forget_anchor", self._forget_anchor)
         self.create_service(srv.ExpectAnchor, "~/expect_anchor", self._expect_anchor)
-        self.create_timer(track_period, self._track)
+        self.create_timer(settings.timing.track_period, self._track)
         # Percept arrays go to a worker through a one-slot mailbox: when anchoring falls behind
         # the camera, the newest frame wins and the replaced ones are counted and reported.
         self._mailbox = NewestFrameMailbox()
@@ -162,68 +121,18 @@ class AnchoringNode(Node):
         self._reported_drops = 0
         self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report_drops)
 
-        self._worker = PersistenceWorker(
-            self._copy_anchors, self._state_file, self._knowledge_base_opener(knowledge_base),
-            Grounding(GroundingConfig.from_yaml(config_path(grounding_file, "grounding.yaml"))),
-            # Restored anchors are this node's objects in the knowledge base, saved as owned or not.
-            owned_objects=(saved.owned_objects if saved else frozenset())
-            | {anchor.symbol for anchor in self._anchoring.anchors},
-            sync_period=sync_period, save_period=save_period, log=self._log,
-        )
-        self._worker.start()
+        self.service.start()
         self._publish_state()
+        knowledge_base = settings.persistence.knowledge_base
         self.get_logger().info(
-            f"anchoring in '{world_frame}' with the {matcher} matcher; "
+            f"anchoring in '{self._world_frame}' with the {settings.matcher.name} matcher; "
             f"knowledge base: {knowledge_base or 'none'}")
 
     def destroy_node(self) -> None:
         self._mailbox.close()
         self._anchoring_thread.join(timeout=5.0)
-        self._worker.stop()
+        self.service.close()
         super().destroy_node()
-
-    # Construction helpers.
-
-    def _make_matcher(self, name: str, weights: str, backbone: str) -> Any:
-        if name == "rules":
-            defaults = RuleMatcherConfig()
-            return RuleMatcher(RuleMatcherConfig(
-                position_sigma=declare_parameter(
-                    self, "rules_position_sigma", defaults.position_sigma,
-                    "rules: distance tolerance (m) of a percept and an anchor seen at the same time.",
-                    minimum=0.01, maximum=10.0),
-                maximum_sigma=declare_parameter(
-                    self, "rules_maximum_sigma", defaults.maximum_sigma,
-                    "rules: the tolerance's cap (m) however long the anchor has not been seen.",
-                    minimum=0.01, maximum=10.0),
-            ))
-        if name == "network":
-            from merlin2_sailor.anchoring.matching_network import NetworkMatcher
-            from merlin2_sailor.models import default_weights_path
-
-            return NetworkMatcher.from_file(weights or default_weights_path(), backbone)
-        raise ConfigurationError(f"unknown matcher '{name}'; use 'rules' or 'network'")
-
-    def _make_embedder(self, backbone: str) -> Any:
-        from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
-
-        return CropEmbedder(EmbeddingConfig(backbone=backbone))
-
-    def _knowledge_base_opener(self, location: str) -> Any:
-        if not location:
-            return None
-        if location.startswith(ROS_PREFIX):
-            from merlin2_sailor.ros.knowledge_base_client import RemoteKnowledgeBase
-
-            namespace = location.removeprefix(ROS_PREFIX) or "/"
-            return lambda: RemoteKnowledgeBase(namespace=namespace, timeout=2.0)
-        return lambda: open_store(location)
-
-    def _new_symbol(self, class_name: str) -> str:
-        symbol = self._symbols(class_name)
-        if self._state_file is not None:  # before the symbol can reach anyone
-            self._state_file.save_symbols(self._symbols.last_indices)
-        return symbol
 
     def _log(self, level: str, message: str) -> None:
         # One call site per severity: rclpy raises ValueError when one line logs at two severities,
@@ -319,29 +228,19 @@ class AnchoringNode(Node):
             result = self._anchoring.track(now, self._robot_pose)
         self._publish(result)
 
-    # Outputs.
-
-    def _copy_anchors(self) -> AnchorsCopy:
-        with self._lock:
-            views = views_of(self._anchoring.anchors)
-
-        def snapshot() -> dict[str, Any]:
-            with self._lock:
-                return self._anchoring.snapshot()
-
-        return AnchorsCopy(views, snapshot)
+    # Outputs: messages are built from views taken under the lock, never from live anchors,
+    # which the frame thread may be changing meanwhile.
 
     def _publish(self, result: AnchoringResult) -> None:
         if not result.events:
             return
         # The anchors the events name, looked up one by one: walking every anchor per frame
         # would cost as much as the frame itself with thousands of anchors.
-        with self._lock:
-            named = {event.symbol: self._anchoring.get(event.symbol) for event in result.events}
-        named.update({anchor.symbol: anchor for anchor in result.forgotten})
-        class_names = {symbol: anchor.class_name for symbol, anchor in named.items() if anchor is not None}
-        tentative = {symbol for symbol, anchor in named.items()
-                     if anchor is not None and anchor.state is AnchorState.TENTATIVE}
+        named = self.service.views_of(event.symbol for event in result.events)
+        with self._lock:  # forgotten anchors have left the core; copied under the lock all the same
+            named.update({anchor.symbol: AnchorView.of(anchor) for anchor in result.forgotten})
+        class_names = {symbol: view.class_name for symbol, view in named.items()}
+        tentative = {symbol for symbol, view in named.items() if view.state is AnchorState.TENTATIVE}
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
         self._events_publisher.publish(events_to_message(result.events, class_names, header))
         for event in result.events:  # a running account; reacquisitions would flood it
@@ -356,20 +255,17 @@ class AnchoringNode(Node):
         self._publish_state()
 
     def _publish_state(self) -> None:
-        with self._lock:
-            anchors = sorted(self._anchoring.anchors, key=lambda anchor: anchor.symbol)
+        views = self.service.views()
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
-        self._anchors_publisher.publish(anchors_to_message(anchors, header))
-        self._markers_publisher.publish(anchor_markers(anchors, header))
+        self._anchors_publisher.publish(anchors_to_message(views, header))
+        self._markers_publisher.publish(anchor_markers(views, header))
 
     # Services.
 
     def _get_anchors(self, request: srv.GetAnchors.Request, response: srv.GetAnchors.Response) -> Any:
-        with self._lock:
-            anchors = [a for a in self._anchoring.anchors
-                       if (not request.symbol or a.symbol == request.symbol)
-                       and (not request.class_name or a.class_name == request.class_name)]
-        response.anchors = anchors_to_message(sorted(anchors, key=lambda a: a.symbol), Header()).anchors
+        views = self.service.views(lambda anchor: (not request.symbol or anchor.symbol == request.symbol)
+                                   and (not request.class_name or anchor.class_name == request.class_name))
+        response.anchors = anchors_to_message(views, Header()).anchors
         response.frame_id = self._world_frame
         return response
 
@@ -381,16 +277,17 @@ class AnchoringNode(Node):
                 if request.use_point else None)
         try:
             with self._lock:
-                found: Anchor | None = self._anchoring.find(
+                anchor = self._anchoring.find(
                     symbol=request.symbol or None, class_name=request.class_name or None, near=near)
-                if found is not None:
-                    response.anchor = anchors_to_message([found], Header()).anchors[0]
+                found = AnchorView.of(anchor) if anchor is not None else None
         except SailorError as error:  # a point that is not 3 finite numbers: refused, not a crash
             response.message = str(error)
             return response
         response.found = found is not None
         if found is None:
             response.message = f"no anchor for {request.symbol or request.class_name!r}"
+        else:
+            response.anchor = anchors_to_message([found], Header()).anchors[0]
         return response
 
     def _forget_anchor(self, request: srv.ForgetAnchor.Request, response: srv.ForgetAnchor.Response) -> Any:

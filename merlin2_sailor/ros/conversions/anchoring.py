@@ -1,4 +1,9 @@
-"""Anchors and anchor events to merlin2_sailor_interfaces messages, and their RViz markers."""
+"""Anchors and anchor events to merlin2_sailor_interfaces messages, and their RViz markers.
+
+The node converts :class:`~merlin2_sailor.anchoring.anchor_view.AnchorView` copies (taken under its
+lock, so another thread's frame cannot change an anchor half-way through its message); a live
+:class:`~merlin2_sailor.anchoring.anchor.Anchor` has the same attributes and converts the same way.
+"""
 
 from __future__ import annotations
 
@@ -10,6 +15,7 @@ from std_msgs.msg import Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_view import AnchorView
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.ros.conversions.sensors import seconds_to_stamp
 from merlin2_sailor_interfaces.msg import Anchor as AnchorMessage
@@ -30,18 +36,22 @@ EVENT_KIND_TO_MESSAGE = MappingProxyType({
     AnchorEventKind.MISSING: AnchorEventMessage.KIND_MISSING,
     AnchorEventKind.FORGOTTEN: AnchorEventMessage.KIND_FORGOTTEN,
     AnchorEventKind.RETRACTED: AnchorEventMessage.KIND_RETRACTED,
+    AnchorEventKind.AMBIGUOUS: AnchorEventMessage.KIND_AMBIGUOUS,
 })
+#: What the conversions read: a frozen view (what nodes pass) or, single-threaded, a live anchor.
+AnchorLike = AnchorView | Anchor
 _STATE_COLOURS = MappingProxyType({
     AnchorState.TENTATIVE: (0.9, 0.8, 0.2), AnchorState.CONFIRMED: (0.2, 0.8, 0.3),
     AnchorState.MISSING: (0.9, 0.3, 0.2), AnchorState.FORGOTTEN: (0.5, 0.5, 0.5),
 })
 
 
-def anchor_to_message(anchor: Anchor) -> AnchorMessage:
+def anchor_to_message(anchor: AnchorLike) -> AnchorMessage:
     message = AnchorMessage(
         symbol=anchor.symbol, class_name=anchor.class_name, state=STATE_TO_MESSAGE[anchor.state],
         confidence=float(anchor.confidence), times_seen=int(anchor.times_seen),
         last_tracker_id=anchor.last_tracker_id,
+        indistinguishable_from=list(anchor.indistinguishable_from),
         first_seen=seconds_to_stamp(anchor.first_seen), last_seen=seconds_to_stamp(anchor.last_seen),
     )
     message.position.x, message.position.y, message.position.z = (float(v) for v in anchor.position)
@@ -49,7 +59,7 @@ def anchor_to_message(anchor: Anchor) -> AnchorMessage:
     return message
 
 
-def anchors_to_message(anchors: Sequence[Anchor], header: Header) -> AnchorArray:
+def anchors_to_message(anchors: Sequence[AnchorLike], header: Header) -> AnchorArray:
     return AnchorArray(header=header, anchors=[anchor_to_message(anchor) for anchor in anchors])
 
 
@@ -67,7 +77,7 @@ def events_to_message(events: Sequence[AnchorEvent], class_names: dict[str, str]
         event_to_message(event, class_names.get(event.symbol, "")) for event in events])
 
 
-def anchor_markers(anchors: Sequence[Anchor], header: Header) -> MarkerArray:
+def anchor_markers(anchors: Sequence[AnchorLike], header: Header) -> MarkerArray:
     """One box and one label per anchor, coloured by state; DELETEALL first drops stale ones."""
     markers = [Marker(header=header, action=Marker.DELETEALL)]
     for index, anchor in enumerate(anchors):
