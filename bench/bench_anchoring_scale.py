@@ -31,10 +31,13 @@ from bench_matching import FEATURE_DIMENSION, GALLERY_VIEWS
 from harness import script
 from harness.results import BenchmarkResult, LinePlot, Table
 
-from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, CameraView, LifecycleConfig
+from merlin2_sailor.anchoring import Anchoring, CameraView
+from merlin2_sailor.anchoring.service import AnchoringService
+from merlin2_sailor.anchoring.settings import OFFLINE_OVERRIDES, load_anchoring_settings
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.contract.pose import Pose
+from merlin2_sailor.resources import config_file
 
 LOCAL_OBJECTS = 20
 FRAMES = 100
@@ -74,8 +77,13 @@ def acquire_far_anchors(anchoring: Anchoring, count: int, rng: np.random.Generat
 
 
 def new_anchoring() -> Anchoring:
-    # the far anchors are acquired without a camera view, so they are never "missing"; keep them
-    return Anchoring(AnchoringConfig(lifecycle=LifecycleConfig(confirm_after=GALLERY_VIEWS)))
+    """The deployed anchoring layer (config/anchoring.yaml, offline, the rule matcher), confirming
+    after GALLERY_VIEWS sightings; the far anchors are acquired without a camera view, so they are
+    never "missing" and stay."""
+    settings = load_anchoring_settings(
+        config_file("anchoring.yaml"),
+        overrides={**OFFLINE_OVERRIDES, "matcher": "rules", "confirm_after": GALLERY_VIEWS})
+    return AnchoringService(settings).anchoring
 
 
 def frame_cost_ms(far_anchors: int, rng: np.random.Generator, frames: int = FRAMES) -> tuple[float, int]:

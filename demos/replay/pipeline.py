@@ -16,7 +16,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from merlin2_sailor.anchoring.anchoring import Anchoring, AnchoringResult
-from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.service import AnchoringService
 from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
@@ -73,7 +73,7 @@ class ReplayPipeline:
         self.detector = detector
         self.tracker = tracker
         # `is None`, not `or`: an Anchoring with no anchors yet has length 0 and is falsy.
-        self.anchoring = Anchoring(source.anchoring_config()) if anchoring is None else anchoring
+        self.anchoring = AnchoringService(source.anchoring_settings()).anchoring if anchoring is None else anchoring
         self.percept_generator = (
             PerceptGenerator(source.percept_config()) if percept_generator is None else percept_generator
         )
@@ -129,19 +129,3 @@ def create_replay_tracker(source: ReplaySource, stride: int) -> FrameTracker:
     from merlin2_sailor.perception.tracker import ByteTrackAdapter, ByteTrackConfig
 
     return ByteTrackAdapter(ByteTrackConfig(frame_rate=source.frame_rate / stride))
-
-
-def create_matcher(name: str) -> tuple[Matcher, Any]:
-    """(matcher, embedder) as the anchoring node makes them: 'rules', or 'network' with its crop embedder."""
-    if name == "rules":
-        from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
-
-        return RuleMatcher(), None
-    if name == "network":
-        from merlin2_sailor.anchoring.matching_network import NetworkMatcher
-        from merlin2_sailor.models import DEFAULT_BACKBONE, default_weights_path
-        from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
-
-        return (NetworkMatcher.from_file(default_weights_path(), DEFAULT_BACKBONE),
-                CropEmbedder(EmbeddingConfig(backbone=DEFAULT_BACKBONE)))
-    raise ConfigurationError(f"unknown matcher '{name}'; use 'rules' or 'network'")

@@ -9,19 +9,21 @@ one from the frame's detections instead (:meth:`ReplaySource.depth_for`).
 
 from __future__ import annotations
 
+import os
 from abc import ABC, abstractmethod
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchoring import AnchoringConfig
+from merlin2_sailor.anchoring.settings import OFFLINE_OVERRIDES, AnchoringSettings, load_anchoring_settings
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGeneratorConfig
+from merlin2_sailor.resources import config_file
 
 #: Rotation taking optical-frame axes (x right, y down, z forward) into a level, z-up world frame
 #: (REP 103) whose x axis is the viewing direction: the camera-to-world rotation of a level camera.
@@ -82,9 +84,24 @@ class ReplaySource(ABC):
         """The percept generator's thresholds suited to this source's range (default: the node's)."""
         return PerceptGeneratorConfig()
 
-    def anchoring_config(self) -> AnchoringConfig:
-        """The anchoring core's configuration suited to this source (default: the node's)."""
-        return AnchoringConfig()
+    def anchoring_overrides(self) -> dict[str, Any]:
+        """Anchoring parameters (by their names in config/anchoring.yaml) this source's camera
+        needs changed from the deployed ones; none by default."""
+        return {}
+
+    def anchoring_settings(
+        self,
+        *parameter_files: str | os.PathLike[str] | Mapping[str, Any],
+        overrides: Mapping[str, Any] | None = None,
+        node: str = "/anchoring",
+    ) -> AnchoringSettings:
+        """The settings the anchoring node ``node`` would run with, from ``parameter_files`` (files
+        and inline values, as a launch file hands them; config/anchoring.yaml when none are given),
+        offline (no knowledge base, no state on disk), with :meth:`anchoring_overrides`, then
+        ``overrides``."""
+        files = parameter_files or (config_file("anchoring.yaml"),)
+        return load_anchoring_settings(
+            *files, overrides={**OFFLINE_OVERRIDES, **self.anchoring_overrides(), **(overrides or {})}, node=node)
 
     def settings(self) -> dict[str, Any]:
         """The source's parameters, for the report."""

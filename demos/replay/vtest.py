@@ -28,9 +28,6 @@ from typing import Any
 import cv2
 import numpy as np
 
-from merlin2_sailor.anchoring.anchoring import AnchoringConfig
-from merlin2_sailor.anchoring.visibility import VisibilityConfig
-from merlin2_sailor.contract.camera import FrustumLimits
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.box3d import Box3DConfig
 from merlin2_sailor.perception.detection import Detection
@@ -130,10 +127,9 @@ class VtestSource(ReplaySource):
         far = self.config.ground.maximum_range
         return PerceptGeneratorConfig(box3d=Box3DConfig(depth_band_half_width=BOARD_DEPTH_BAND, maximum_depth=far))
 
-    def anchoring_config(self) -> AnchoringConfig:
+    def anchoring_overrides(self) -> dict[str, Any]:
         # Everyone in the picture is tens of metres away: the whole view counts for visibility.
-        frustum = FrustumLimits(near=1.0, far=self.config.ground.maximum_range, margin=10.0)
-        return AnchoringConfig(visibility=VisibilityConfig(frustum=frustum))
+        return {"visible_near": 1.0, "visible_range": self.config.ground.maximum_range, "visible_margin": 10.0}
 
     def settings(self) -> dict[str, Any]:
         ground = self.config.ground

@@ -7,7 +7,9 @@ and over the look-alike pairs (same class, near). Then each scene is replayed th
 anchoring layer with each matcher and the symbols are scored against the ground truth (ID
 switches, IDF1, via motmetrics). Text on stdout; with ``--output``, a confusion-matrix PNG and
 a JSON of every number. ``--source`` evaluates on a public data set's split instead (see
-``sailor train``).
+``sailor train``). Both matchers and the anchoring layer are built from the anchoring node's
+settings (config/anchoring.yaml; ``--launch``, ``--params``, ``--set`` as for ``sailor replay``),
+by name through the matcher registry, so the figures are the deployed system's.
 """
 
 from __future__ import annotations
@@ -15,10 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
+from merlin2_sailor.cli.anchoring_settings import add_settings_arguments, settings_from_arguments
 from merlin2_sailor.cli.train_command import SOURCE_HELP, embedding_cache, pair_source
+
+#: The matchers compared, each built from the same settings, by name.
+COMPARED_MATCHERS = ("network", "rules")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -28,7 +34,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                     "confusion matrix and metrics table, and identity metrics of the whole anchoring layer.",
     )
     parser.add_argument("--weights", default="", metavar="PATH",
-                        help="weights file (default: the weights shipped in merlin2_sailor/models)")
+                        help="weights file (default: the parameter files' weights, else the ones shipped in "
+                             "merlin2_sailor/models)")
     parser.add_argument("--source", default="generated", metavar="SPEC", help=SOURCE_HELP)
     parser.add_argument("--split", default="test",
                         help="split to evaluate on (default test; a public data set also has 'all')")
@@ -42,13 +49,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-cache", action="store_true", help="keep embeddings in memory only")
     parser.add_argument("--darknet", default="", metavar="DIR", help="darknet photo folder")
     parser.add_argument("--no-darknet", action="store_true", help="use scikit-image's photos only")
+    add_settings_arguments(parser)
     parser.set_defaults(run=run)
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from merlin2_sailor.anchoring.matching_network import NetworkMatcher, load_network
-    from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
-    from merlin2_sailor.models import DEFAULT_BACKBONE, default_weights_path
+    from merlin2_sailor.anchoring.matcher_registry import create_matcher
+    from merlin2_sailor.anchoring.settings import parameter_values
+    from merlin2_sailor.models import default_weights_path
     from merlin2_sailor.training.generated_dataset import GeneratedPairSet
     from merlin2_sailor.training.identity_evaluation import evaluate_identities, format_identity_table
     from merlin2_sailor.training.metrics import format_confusion, format_table
@@ -57,25 +65,25 @@ def run(arguments: argparse.Namespace) -> int:
     from merlin2_sailor.training.plots import plot_confusions
 
     started = time.perf_counter()
-    weights = Path(arguments.weights) if arguments.weights else default_weights_path()
-    network = load_network(weights, DEFAULT_BACKBONE)
+    # The anchoring node's settings (the same parameter files), offline; each matcher compared is
+    # built from them by name, as the node builds its own.
+    settings = settings_from_arguments(arguments, {"weights": arguments.weights} if arguments.weights else None)
+    weights = Path(settings.matcher.weights).expanduser() if settings.matcher.weights else default_weights_path()
+    built = {name: create_matcher(replace(settings.matcher, name=name)) for name in COMPARED_MATCHERS}
     source = pair_source(arguments)
     pair_set = GeneratedPairSet(source, arguments.split, arguments.scenes, PairDatasetConfig(), arguments.first)
-    cache = embedding_cache(arguments, network.metadata.backbone)
+    # The crops' features are cached by backbone; percepts carry them, so no embedder is built.
+    cache = embedding_cache(arguments, settings.matcher.backbone)
     pair_set.embed(cache)
 
-    def network_matcher() -> NetworkMatcher:
-        return NetworkMatcher(network)
-
-    def rule_matcher() -> RuleMatcher:
-        return RuleMatcher()
-
-    matchers = {"network": network_matcher, "rules": rule_matcher}
-    pairs = {name: evaluate_pairs(factory(), pair_set.chunks(), cache) for name, factory in matchers.items()}
+    # Matchers are stateless: each scene gets a fresh Anchoring around the same one.
+    matchers = {name: (lambda matcher=matcher: matcher) for name, matcher in built.items()}
+    threshold = settings.core.match_threshold
+    pairs = {name: evaluate_pairs(factory(), pair_set.chunks(), cache, threshold) for name, factory in matchers.items()}
     table = {name: result.all_pairs for name, result in pairs.items()}
     table.update({f"{name} look-alike": result.look_alike for name, result in pairs.items()})
     print(f"weights {weights}; split {arguments.split!r}, scenes {arguments.first}.."
-          f"{arguments.first + arguments.scenes - 1}, seed {arguments.seed}, threshold 0.5\n")
+          f"{arguments.first + arguments.scenes - 1}, seed {arguments.seed}, threshold {threshold:g}\n")
     print("pairs (Algorithm 3, every pair; look-alike = same class, nearer than 1 m)")
     print(format_table(table))
     print()
@@ -86,7 +94,8 @@ def run(arguments: argparse.Namespace) -> int:
     identities = {}
     if not arguments.no_identity:
         identities = {
-            name: evaluate_identities(factory, pair_set.scenes(), cache) for name, factory in matchers.items()
+            name: evaluate_identities(factory, pair_set.scenes(), cache, settings.core)
+            for name, factory in matchers.items()
         }
         print("anchoring (the whole layer replayed over each scene; percepts vs ground-truth instances)")
         print(format_identity_table(identities))
@@ -104,6 +113,7 @@ def run(arguments: argparse.Namespace) -> int:
             "pairs": {name: counts.as_dict() for name, counts in table.items()},
             "anchoring": {name: metrics.as_dict() for name, metrics in identities.items()},
             "source_config": asdict(source.config),
+            "anchoring_settings": parameter_values(settings),
             "seconds": round(seconds, 1),
         }
         (folder / "metrics.json").write_text(json.dumps(report, indent=2, default=str) + "\n")

@@ -14,6 +14,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from merlin2_sailor.cli.anchoring_settings import add_settings_arguments, parameter_sources, set_parameters
+
 SOURCES = ("motorcycle", "sr300", "vtest")
 
 
@@ -36,8 +38,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="detector backend: ssd (SSD-MobileNet-v2 COCO, offline) or ultralytics")
     parser.add_argument("--score-threshold", type=float, default=None, metavar="X",
                         help="detector score threshold (default: the backend's, 0.5)")
-    parser.add_argument("--matcher", default="rules", choices=("rules", "network"),
-                        help="anchoring matching function")
+    parser.add_argument("--matcher", default=None, metavar="NAME",
+                        help="anchoring matching function, rules or network (default: the parameter files')")
     parser.add_argument("--every", type=int, default=None, metavar="K",
                         help="write every K-th processed frame as PNG (default: about a dozen images)")
     parser.add_argument("--no-video", action="store_true", help="do not write the annotated video")
@@ -51,6 +53,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                        help="camera pitch below the horizon in degrees (default 34)")
     vtest.add_argument("--field-of-view", type=float, default=None, metavar="DEG",
                        help="horizontal field of view in degrees (default 60)")
+    add_settings_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -66,14 +69,10 @@ def source_options(arguments: argparse.Namespace) -> dict[str, object]:
 
 
 def run(arguments: argparse.Namespace) -> int:
-    from merlin2_sailor.anchoring.anchoring import Anchoring
+    from merlin2_sailor.anchoring.service import AnchoringService
+    from merlin2_sailor.anchoring.settings import parameter_values
     from merlin2_sailor.errors import ConfigurationError
-    from merlin2_sailor_demos.replay.pipeline import (
-        ReplayPipeline,
-        create_matcher,
-        create_replay_detector,
-        create_replay_tracker,
-    )
+    from merlin2_sailor_demos.replay.pipeline import ReplayPipeline, create_replay_detector, create_replay_tracker
     from merlin2_sailor_demos.replay.runner import ReplayOptions, format_summary, run_replay
     from merlin2_sailor_demos.replay.sources import create_source, source_class
 
@@ -82,19 +81,23 @@ def run(arguments: argparse.Namespace) -> int:
         if value is not None and value < smallest:
             raise ConfigurationError(f"{option} must be at least {smallest}, got {value}")
     source_class(arguments.source)  # an unknown name fails here, before any data is fetched
+    # The anchoring node's own settings (the same files, read the same way), offline, with what the
+    # source's camera needs, then the command line's.
+    parameter_files, node = parameter_sources(arguments)
+    overrides = {**({"matcher": arguments.matcher} if arguments.matcher else {}), **set_parameters(arguments)}
     source = create_source(arguments.source, source_options(arguments))
+    settings = source.anchoring_settings(*parameter_files, overrides=overrides, node=node)
     detector = create_replay_detector(arguments.detector, arguments.score_threshold)
-    matcher, embedder = create_matcher(arguments.matcher)
-    pipeline = ReplayPipeline(
-        source, detector, create_replay_tracker(source, arguments.stride),
-        Anchoring(source.anchoring_config(), matcher, embedder),
-    )
+    service = AnchoringService(settings)
+    pipeline = ReplayPipeline(source, detector, create_replay_tracker(source, arguments.stride), service.anchoring)
     output = Path(arguments.output) if arguments.output else Path("reports") / "replay" / source.name
     options = ReplayOptions(
         output=output, frames=arguments.frames, stride=arguments.stride, first=arguments.first,
         image_every=arguments.every, video=not arguments.no_video,
         header={"detector": arguments.detector, "score_threshold": arguments.score_threshold,
-                "matcher": arguments.matcher},
+                "matcher": settings.matcher.name,
+                "parameter_files": [str(item) if isinstance(item, Path) else item for item in parameter_files],
+                "anchoring": parameter_values(settings)},
     )
     report = run_replay(pipeline, options)
     print()

@@ -95,11 +95,35 @@ def test_the_pipeline_anchors_into_the_core_it_is_given() -> None:
     from merlin2_sailor.anchoring.symbols import SymbolCounter
 
     source = TinySource(1)
-    anchoring = Anchoring(source.anchoring_config(), symbol_factory=SymbolCounter({"cup": 6}))
+    anchoring = Anchoring(source.anchoring_settings().core, symbol_factory=SymbolCounter({"cup": 6}))
     pipeline = ReplayPipeline(source, ScriptedDetector(cup_and_book(1)), None, anchoring)
     assert pipeline.anchoring is anchoring  # even while it is empty (and so falsy)
     (outcome,) = [pipeline.step(frame) for frame in source.frames([0])]
     assert [box.symbol for box in outcome.boxes] == ["cup_7", "book_1"] and len(anchoring) == 2
+
+
+def test_a_source_runs_the_anchoring_nodes_settings_offline_with_what_its_camera_needs(tmp_path) -> None:
+    from merlin2_sailor.anchoring.settings import load_anchoring_settings
+    from merlin2_sailor.resources import config_file
+
+    deployed = load_anchoring_settings(config_file("anchoring.yaml"))
+    settings = TinySource(1).anchoring_settings()
+    assert settings.core == deployed.core and settings.matcher == deployed.matcher
+    assert (settings.persistence.knowledge_base, settings.persistence.state_folder) == ("", "")
+    # A default pipeline runs exactly that.
+    assert ReplayPipeline(TinySource(1), ScriptedDetector([]), None).anchoring.config == deployed.core
+
+    class FarSource(TinySource):
+        def anchoring_overrides(self):
+            return {"visible_range": 30.0, "forget_after": 5.0}
+
+    parameters = tmp_path / "robot.yaml"
+    parameters.write_text("anchoring:\n  ros__parameters: {visible_range: 4.0, confirm_after: 5, forget_after: 9.0}\n")
+    settings = FarSource(1).anchoring_settings(parameters, overrides={"forget_after": 7.0})
+    # The file's values, then the source's camera, then the caller's.
+    assert settings.core.lifecycle.confirm_after == 5
+    assert settings.core.visibility.frustum.far == 30.0
+    assert settings.core.lifecycle.forget_after == 7.0
 
 
 def test_a_detection_without_depth_is_reported_and_not_anchored() -> None:

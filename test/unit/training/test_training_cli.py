@@ -32,10 +32,13 @@ def test_train_then_evaluate_a_few_scenes(tmp_path, capsys) -> None:
     assert weights.is_file() and (tmp_path / "net_loss.png").is_file()
     assert json.loads(weights.with_suffix(".json").read_text())["splits"] == {"train": 2, "validation": 1, "test": 0}
     assert main(["evaluate", "--weights", str(weights), "--scenes", "1", "--output", str(tmp_path / "eval"),
-                 *cache]) == 0
+                 "--set", "match_threshold=0.6", *cache]) == 0
     output = capsys.readouterr().out
     assert "network look-alike" in output and "IDF1" in output
     report = json.loads((tmp_path / "eval" / "metrics.json").read_text())
+    # The anchoring node's settings, with the command line's: both matchers are judged at them.
+    assert "threshold 0.6" in output and report["anchoring_settings"]["match_threshold"] == 0.6
+    assert report["anchoring_settings"]["weights"] == str(weights)
     assert set(report["pairs"]) == {"network", "rules", "network look-alike", "rules look-alike"}
     assert (tmp_path / "eval" / "confusion.png").is_file()
 
