@@ -17,9 +17,6 @@ from merlin2_sailor.plugins import PluginTable
 
 MEMORY = "memory"
 SCHEME_SEPARATOR = "://"
-#: Only for ros/anchoring_node.py until it opens its store through merlin2_sailor.ros.stores.open_store;
-#: then delete it (this layer has no ros:// store).
-ROS_PREFIX = "ros://"
 
 #: Scheme -> "module:Class" of every ROS-free store.
 STORES = PluginTable(
