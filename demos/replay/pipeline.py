@@ -21,7 +21,7 @@ from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.detection import Detection
-from merlin2_sailor.perception.detector import DETECTOR_BACKENDS, create_detector
+from merlin2_sailor.perception.detector_registry import DETECTOR_BACKENDS, create_detector
 from merlin2_sailor.perception.percept_generator import PerceptGenerator
 from merlin2_sailor_demos.replay.source import ReplayFrame, ReplaySource
 
