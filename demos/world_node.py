@@ -360,6 +360,9 @@ class WorldNode(Node):
                 return
             self._written_version = self._world.version
             truth = self._world.ground_truth()
+        # The wall-clock stamp of this version (the clock the camera frames carry), so a reader can
+        # tell which version was in force when an anchor last saw its object.
+        truth["stamp"] = self.get_clock().now().nanoseconds * 1e-9
         try:
             self._report_path.parent.mkdir(parents=True, exist_ok=True)
             temporary = self._report_path.with_suffix(".json.tmp")

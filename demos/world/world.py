@@ -39,6 +39,17 @@ from merlin2_sailor_demos.world.world_file import WorldDescription
 PHYSICS_STEP = 0.02
 #: A goal this close (m) to a waypoint counts as a visit to it (scenario ``after_visiting``).
 VISIT_RADIUS = 0.3
+#: The robot counts as moving while its true pose changes by more than this per step (m, rad).
+STILL_TOLERANCE = 1e-4
+
+
+@dataclass
+class _Glide:
+    """A ``move`` with a speed, under way: the object travels from ``source`` to the destination."""
+
+    event: ScenarioEvent
+    item: WorldObject
+    source: tuple[float, float, float]
 
 
 class NavigationState(Enum):
@@ -102,6 +113,9 @@ class World:
         """Incremented whenever the ground truth changes beyond the robot's motion (objects, arrivals)."""
         self._goals = 0
         self.navigation: NavigationGoal | None = None
+        self._last_motion = 0.0  # simulated time the robot last moved or turned
+        self._visited_since: dict[str, set[str]] = {}  # fired event -> waypoints arrived at since
+        self._glides: list[_Glide] = []
 
     # --- time -------------------------------------------------------------------------------------------
 
@@ -110,11 +124,13 @@ class World:
         if not (dt >= 0.0 and math.isfinite(dt)):
             raise InvalidInputError(f"a world step must be a finite, non-negative duration, got {dt}")
         remaining = dt
+        arrived: list[FiredEvent] = []
         while remaining > 1e-12:
             step = min(PHYSICS_STEP, remaining)
             self._physics_step(step)
+            arrived += self._advance_glides(step)
             remaining -= step
-        return self._run_scenario()
+        return arrived + self._run_scenario()
 
     def _physics_step(self, dt: float) -> None:
         self.time += dt
@@ -127,6 +143,9 @@ class World:
         velocity = goal.follower.command(self.odometry.estimate, dt)
         before = self.true_pose
         self.true_pose = integrate(before, velocity, dt)
+        if max(abs(self.true_pose.x - before.x), abs(self.true_pose.y - before.y),
+               abs(self.true_pose.yaw - before.yaw)) > STILL_TOLERANCE:
+            self._last_motion = self.time
         self.odometry.update(before, self.true_pose, dt)
         period = self.odometry.noise.localisation_period
         self._since_fix += dt
@@ -145,6 +164,8 @@ class World:
         for waypoint in self.house.waypoints:
             if math.hypot(waypoint.pose.x - goal.x, waypoint.pose.y - goal.y) <= VISIT_RADIUS:
                 self.visited.add(waypoint.name)
+                for since in self._visited_since.values():
+                    since.add(waypoint.name)
         self.version += 1
 
     # --- navigation ---------------------------------------------------------------------------------------
@@ -249,23 +270,65 @@ class World:
 
     def progress(self) -> Progress:
         room = self.house.room_at(self.true_pose.x, self.true_pose.y)
-        return Progress(self.time, self.arrivals, frozenset(self.visited), room.name if room else None)
+        return Progress(self.time, self.arrivals, frozenset(self.visited), room.name if room else None,
+                        self.time - self._last_motion,
+                        {name: frozenset(since) for name, since in self._visited_since.items()})
 
     def _run_scenario(self) -> list[FiredEvent]:
         fired = []
         for event in self.scenario.due(self.progress()):
             result = self._apply(event)
-            if result is not None:
-                self.scenario.record(event, result)
+            if isinstance(result, FiredEvent):
+                self._record(event, result)
                 fired.append(result)
                 self.version += 1
+            elif isinstance(result, _Glide):
+                self.scenario.start(event)
+                self._glides.append(result)
         return fired
 
-    def _apply(self, event: ScenarioEvent) -> FiredEvent | None:
-        """Apply ``event`` unless the camera would see it happen; None means 'not now'."""
+    def _advance_glides(self, dt: float) -> list[FiredEvent]:
+        """Move every gliding object ``dt`` seconds further; the events of those that arrive."""
+        arrived = []
+        for glide in list(self._glides):
+            item, event = glide.item, glide.event
+            if item.carried or item not in self.objects:  # picked up or removed on the way: the glide ends
+                self._glides.remove(glide)
+                self._record(event, FiredEvent(event.name, "move interrupted", item.id, self.time, glide.source,
+                                               None))
+                continue
+            target = np.array(event.destination, dtype=float)
+            offset = target - item.position[:2]
+            distance = float(np.hypot(*offset))
+            step = event.speed * dt
+            xy = target if distance <= step else item.position[:2] + offset * (step / distance)
+            item.position = self._standing_at(item, float(xy[0]), float(xy[1]))
+            self.version += 1
+            if distance <= step:
+                self._glides.remove(glide)
+                fired = FiredEvent(event.name, "move", item.id, self.time, glide.source,
+                                   tuple(float(v) for v in item.position))
+                self._record(event, fired)
+                arrived.append(fired)
+        return arrived
+
+    def _record(self, event: ScenarioEvent, fired: FiredEvent) -> None:
+        self.scenario.record(event, fired)
+        self._visited_since[event.name] = set()
+
+    def _standing_at(self, item: WorldObject, x: float, y: float) -> np.ndarray:
+        return np.array([x, y, self.house.support_height(x, y) + item.size[2] / 2.0])
+
+    def _may_happen(self, event: ScenarioEvent, *boxes: Box) -> bool:
+        """Whether the camera's view allows ``event`` now: all boxes in view if watched, else none."""
+        seen = [self.in_view(box) for box in boxes]
+        return all(seen) if event.watched else not any(seen)
+
+    def _apply(self, event: ScenarioEvent) -> FiredEvent | _Glide | None:
+        """Apply ``event`` (or start its glide) if the camera's view allows it; None means 'not now'."""
         if event.action == "add":
             new = self._new_object(event.spec)
-            if self.in_view(new.box):
+            if not self._may_happen(event, new.box):
                 return None
             self.objects.append(new)
             return FiredEvent(event.name, "add", event.object_id, self.time, None, tuple(new.position))
@@ -274,18 +337,19 @@ class World:
         except InvalidInputError:
             return FiredEvent(event.name, f"{event.action} skipped: no such object", event.object_id, self.time,
                               None, None)
-        if item.carried:
-            return None  # wait until the robot puts it down
-        if self.in_view(item.box):
-            return None
+        if item.carried or any(glide.item is item for glide in self._glides):
+            return None  # wait until the robot puts it down, or it has arrived
         source = tuple(float(v) for v in item.position)
         if event.action == "remove":
+            if not self._may_happen(event, item.box):
+                return None
             self.objects.remove(item)
             return FiredEvent(event.name, "remove", item.id, self.time, source, None)
-        x, y = event.destination
-        moved = np.array([x, y, self.house.support_height(x, y) + item.size[2] / 2.0])
-        if self.in_view(Box(tuple(moved), item.size)):
+        moved = self._standing_at(item, *event.destination)
+        if not self._may_happen(event, item.box, Box(tuple(moved), item.size)):
             return None
+        if event.speed is not None:
+            return _Glide(event, item, source)
         item.position = moved
         return FiredEvent(event.name, "move", item.id, self.time, source, tuple(float(v) for v in moved))
 

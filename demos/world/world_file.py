@@ -1,9 +1,12 @@
 """A world file: the house, the object textures and objects, the robot, its camera, the scenario.
 
 One YAML file (``config/worlds/house.yaml`` is the example) with the sections ``house``,
-``textures``, ``objects``, and optionally ``robot``, ``camera``, ``depth_sensor`` and
-``scenario``. Loading checks the sections against each other (object ids unique, every object in
-a room, every scenario event about an object that exists by then) and says where a mistake is.
+``textures``, ``objects``, and optionally ``robot``, ``camera``, ``depth_sensor``, ``scenario``,
+a one-line ``description`` and the demo's ``mission`` (:mod:`.mission`). A file may instead
+``extends`` another and list only its differences (:mod:`.world_extension`: the scenarios of
+``config/worlds/scenarios/``). Loading checks the sections against each other (object ids unique,
+every object in a room, every scenario event about an object that exists by then, every name the
+mission uses) and says where a mistake is.
 """
 
 from __future__ import annotations
@@ -13,22 +16,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor_demos.world.camera import CameraConfig
 from merlin2_sailor_demos.world.depth_sensor import DepthSensorConfig
 from merlin2_sailor_demos.world.geometry import Pose2D
 from merlin2_sailor_demos.world.gripper import GripperConfig
 from merlin2_sailor_demos.world.house import House
+from merlin2_sailor_demos.world.mission import MissionSpec
 from merlin2_sailor_demos.world.motion import MotionLimits, limits_from_mapping
 from merlin2_sailor_demos.world.objects import ObjectSpec
 from merlin2_sailor_demos.world.odometry import OdometryNoise
 from merlin2_sailor_demos.world.scenario import ScenarioEvent
 from merlin2_sailor_demos.world.textures import TextureSpec
+from merlin2_sailor_demos.world.world_extension import EXTENDS, REMOVE_OBJECTS, read_world_mapping
 from merlin2_sailor_demos.world.yaml_fields import Fields
 
-SECTIONS = ("house", "textures", "objects", "robot", "camera", "depth_sensor", "scenario")
+SECTIONS = ("house", "textures", "objects", "robot", "camera", "depth_sensor", "scenario", "description", "mission")
 
 
 @dataclass(frozen=True)
@@ -70,9 +73,15 @@ class WorldDescription:
     depth_sensor: DepthSensorConfig = field(default_factory=DepthSensorConfig)
     scenario: tuple[ScenarioEvent, ...] = ()
     source: str = ""
+    description: str = ""
+    mission: MissionSpec | None = None
+    """The file's ``mission`` section; None when it has none (the demo then runs MissionSpec())."""
 
     @classmethod
     def from_mapping(cls, data: Any, where: str = "world") -> WorldDescription:
+        if isinstance(data, Mapping) and (EXTENDS in data or REMOVE_OBJECTS in data):
+            raise ConfigurationError(f"{where}: '{EXTENDS}' and '{REMOVE_OBJECTS}' work in a world file "
+                                     "(load_world resolves them against the file's folder), not in a mapping")
         fields = Fields(data, where, SECTIONS)
         house = House.from_mapping(fields.raw("house"), f"{where}: house")
         texture_data = fields.raw("textures")
@@ -90,22 +99,18 @@ class WorldDescription:
             house, textures, objects, robot,
             CameraConfig.from_mapping(fields.raw("camera", {}), f"{where}: camera"),
             DepthSensorConfig.from_mapping(fields.raw("depth_sensor", {}), f"{where}: depth_sensor"),
-            scenario, where,
+            scenario, where, fields.text("description", ""),
+            MissionSpec.from_mapping(fields.raw("mission"), f"{where}: mission") if fields.has("mission") else None,
         )
         _check_consistency(description, where)
         return description
 
 
 def load_world(path: str | Path) -> WorldDescription:
-    """Read and check a world file; every problem is one ConfigurationError naming the file."""
+    """Read and check a world file (its ``extends`` resolved); every problem is one
+    ConfigurationError naming the file."""
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise ConfigurationError(f"cannot read world file {path}: {error.strerror or error}") from error
-    except yaml.YAMLError as error:
-        raise ConfigurationError(f"world file {path} is not valid YAML: {error}") from error
-    return WorldDescription.from_mapping(data, path.name)
+    return WorldDescription.from_mapping(read_world_mapping(path), path.name)
 
 
 def _check_consistency(description: WorldDescription, where: str) -> None:
@@ -119,6 +124,10 @@ def _check_consistency(description: WorldDescription, where: str) -> None:
             raise ConfigurationError(f"{where}: object '{spec.id}' at {spec.xy} is in no room")
     rooms = {room.name for room in house.rooms}
     waypoints = {waypoint.name for waypoint in house.waypoints}
+    names = [event.name for event in description.scenario]
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise ConfigurationError(f"{where}: scenario event names must be unique; repeated: {repeated}")
     for event in description.scenario:
         about = f"{where}: scenario event '{event.name}'"
         unknown_rooms = sorted(set(event.trigger.robot_in + event.trigger.robot_not_in) - rooms)
@@ -128,6 +137,9 @@ def _check_consistency(description: WorldDescription, where: str) -> None:
         if unknown_waypoints:
             raise ConfigurationError(
                 f"{about}: unknown waypoint(s) {unknown_waypoints}; waypoints: {sorted(waypoints)}")
+        if event.trigger.after_event is not None and event.trigger.after_event not in set(names) - {event.name}:
+            raise ConfigurationError(f"{about}: after_event names '{event.trigger.after_event}', not another "
+                                     f"event of this file (events: {sorted(names)})")
         if event.action == "add":
             if event.object_id in ids:
                 raise ConfigurationError(f"{about}: adds '{event.object_id}', which already exists")
@@ -136,3 +148,7 @@ def _check_consistency(description: WorldDescription, where: str) -> None:
             raise ConfigurationError(f"{about}: no object '{event.object_id}' (objects: {sorted(ids)})")
         if event.destination is not None and house.room_at(*event.destination) is None:
             raise ConfigurationError(f"{about}: destination {event.destination} is in no room")
+    if description.mission is not None:
+        initial = {spec.id for spec in description.objects}
+        description.mission.check(initial, ids - initial, waypoints, {event.name for event in description.scenario},
+                                  f"{where}: mission")

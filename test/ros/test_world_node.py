@@ -128,6 +128,23 @@ def test_frames_navigation_and_grasp(ros_probe, node_process, tmp_path) -> None:
     red_mug = next(item for item in truth["objects"] if item["id"] == "red_mug")
     assert red_mug["room"] == "living_room" and not red_mug["carried"]
     assert truth["robot"]["arrivals"] == 1 and truth["robot"]["visited"] == ["living_room"]
+    # The version is stamped on the camera's clock, so a reader can tell which version an anchor's
+    # last sighting belongs to: after the first frame, before the end.
+    first_frame = frame["color"].header.stamp.sec + frame["color"].header.stamp.nanosec * 1e-9
+    assert first_frame < truth["stamp"] < first_frame + 120.0
+
+
+def test_a_scenario_world_file_extends_the_house(ros_probe, node_process, tmp_path) -> None:
+    process = node_process("world", "--ros-args", "-r", f"__ns:={NAMESPACE}", "-p", "rate_hz:=5.0",
+                           "-p", "world_file:=worlds/scenarios/crowded_shelf.yaml", "-p", f"report_folder:={tmp_path}")
+    try:
+        # A pose from the simulation loop: the node is past its start (and its log line).
+        assert ros_probe.collect(PoseStamped, f"{NAMESPACE}/robot_pose", 1, SENSOR_DATA), process.text
+    finally:
+        assert process.stop() == 0, process.text
+    ids = {item["id"] for item in json.loads((tmp_path / "ground_truth.json").read_text())["objects"]}
+    assert {f"shelf_book_{n}" for n in range(1, 8)} <= ids and "book_1" not in ids and "red_mug" in ids
+    assert "world 'crowded_shelf.yaml' (27 objects" in process.text
 
 
 def _point(x: float, y: float) -> Point:
