@@ -54,6 +54,7 @@ setup(
         (f"share/{PACKAGE_NAME}", ["package.xml"]),
         (f"share/{PACKAGE_NAME}/config", glob("config/*.*")),
         (f"share/{PACKAGE_NAME}/config/worlds", glob("config/worlds/*.yaml")),
+        (f"share/{PACKAGE_NAME}/config/worlds/scenarios", glob("config/worlds/scenarios/*.yaml")),
         (f"share/{PACKAGE_NAME}/launch", glob("launch/*")),
     ],
     package_data={"merlin2_sailor": ["models/*.pt", "models/*.json"]},

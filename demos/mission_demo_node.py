@@ -1,20 +1,28 @@
 """The ``mission_demo`` node: the README's main job, a mission in the simulated house, with a report.
 
 It drives the graph of ``launch/demo.yaml`` (world, perception, anchoring, knowledge base,
-behaviours) through two missions and scores the result against the world's ground truth:
+behaviours) through the missions of the world file's ``mission`` section
+(:mod:`merlin2_sailor_demos.world.mission`; without one, the default story below) and scores
+the result against the world's ground truth:
 
 1. look around the room the robot starts in, explore the rest of the house (``explored`` every
-   waypoint), then go to the hall: everything in view gets anchored, and the knowledge base says
-   where;
-2. the red mug is named by its anchor (the user points at it: the demo looks up which anchor is
-   where the world has the red mug), and the world moves the mug while the robot is away;
-3. "find the red mug and go to it" (``robot_near(<symbol>)``): the plan relies on where the mug
+   waypoint, or those the mission names): everything in view gets anchored, and the knowledge
+   base says where;
+2. the target (the red mug) is named by its anchor (the user points at it: the demo looks up
+   which anchor is where the world had the mug at the start), and so is every other object;
+3. the route: go to the hall, and wait while the world moves the mug behind the robot's back
+   (a scenario may have several stops, each waiting for events of its own);
+4. "find the red mug and go to it" (``robot_near(<symbol>)``): the plan relies on where the mug
    was; on arrival the camera sees the place empty, the fact is retracted, the mission replans,
    find_object searches and reacquires the mug elsewhere under the same symbol.
 
 While it runs it prints the running account and saves an annotated camera frame every
 ``frame_period`` seconds; at the end it writes the report folder (summary.md, scorecard.json,
-map.png, frames/, knowledge.pddl, account.log) and exits 0 when the demo showed what it should.
+map.png, frames/, knowledge.pddl, account.log). scorecard.json's ``claims`` say what the
+mission claimed and what each symbol refers to (by its anchor's last sighting), and
+``verdict`` whether the claims are true (:mod:`merlin2_sailor_demos.report.verdict`). It exits
+0 when the demo showed what it should: the default story succeeded or, for a world file with a
+mission, the verdict is right.
 """
 
 from __future__ import annotations
@@ -26,6 +34,7 @@ import time
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
+from dataclasses import replace as dataclass_replace
 from pathlib import Path
 from typing import Any
 
@@ -49,6 +58,7 @@ from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
 from merlin2_sailor_behaviors.mission.account import AnchorEventWording, describe_fact_changes
 from merlin2_sailor_behaviors.mission.mission_node import anchor_event_lines, open_knowledge_base
 from merlin2_sailor_behaviors.mission.session import ForwardToRosLogger, MissionSession, SessionConfig
+from merlin2_sailor_behaviors.planning import MissionResult
 from merlin2_sailor_demos.report import (
     AnchorRecord,
     DemoOutcome,
@@ -60,12 +70,23 @@ from merlin2_sailor_demos.report import (
     write_report,
 )
 from merlin2_sailor_demos.report.annotated_frame import AnchorInView, annotate_frame
+from merlin2_sailor_demos.report.scorecard import CLAIMING_STATES
+from merlin2_sailor_demos.report.truth_timeline import TruthTimeline, refers_to
 from merlin2_sailor_demos.world import load_world
-from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray
+from merlin2_sailor_demos.world.mission import MissionSpec, RouteStop
+from merlin2_sailor_demos.world.scenario import ScenarioEvent
+from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEvent, AnchorEventArray
 
 _STATE_NAMES = {0: "tentative", 1: "confirmed", 2: "missing", 3: "forgotten"}
 EXPLORE_ACTIONS = ("navigation", "explore")
 FETCH_ACTIONS = ("navigation", "approach_object", "find_object")
+#: An anchor seen this recently (s) is in view: only those are associated for the identity
+#: history, as MOT metrics associate only the hypotheses of the current frame (a stale anchor
+#: where another object now stands is no confusion the robot made).
+FRESH_SECONDS = 1.5
+#: Seconds to let the last anchors and facts arrive before the report (and the identification).
+SETTLE_SECONDS = 1.5
+_PAST = {"move": "moved", "remove": "removed", "add": "added"}
 
 
 @dataclass(frozen=True)
@@ -80,7 +101,9 @@ class _FrameToDraw:
 
 
 def _stamp(message: Any) -> float:
-    return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+    """The stamp of a message with a header, or of one that is stamped itself (an anchor event)."""
+    stamp = message.header.stamp if hasattr(message, "header") else message.stamp
+    return stamp.sec + stamp.nanosec * 1e-9
 
 
 _SAME_FRAME = 0.005  # s: colour and depth of one camera frame carry the same stamp
@@ -109,9 +132,11 @@ class MissionDemoNode(Node):
         grounding_file = config_path(declare_parameter(
             self, "grounding", "worlds/house_grounding.yaml", "The grounding the anchoring node uses."),
             "grounding.yaml")
-        self._target = declare_parameter(self, "target", "red_mug", "World id of the object to find.")
-        self._away_from = declare_parameter(
-            self, "wait_at", "hall", "Waypoint the robot goes to after exploring, while the world moves the target.")
+        target = declare_parameter(
+            self, "target", "", "World id of the object to find; empty: the world file's mission's (red_mug).")
+        wait_at = declare_parameter(
+            self, "wait_at", "", "Waypoint the robot goes to after exploring, while the world moves the target; "
+            "empty: the world file's mission's route (the hall).")
         self._frame_period = declare_parameter(
             self, "frame_period", 2.0, "Seconds between annotated frames saved.", minimum=0.2, maximum=600.0)
         self._move_timeout = declare_parameter(
@@ -119,6 +144,18 @@ class MissionDemoNode(Node):
             maximum=600.0)
         self.exit_code: int | None = None
         self._world = load_world(world_file)
+        mission = self._world.mission or MissionSpec()
+        self._judged = self._world.mission is not None  # a scenario: its verdict decides the exit code
+        if target:
+            mission = dataclass_replace(mission, target=target)
+        if wait_at:
+            mission = dataclass_replace(mission, route=(RouteStop(wait_at),))
+        self._mission = mission
+        self._target = mission.target
+        self._symbols_before: dict[str, str] = {}
+        self._timeline = TruthTimeline()
+        self._ambiguous: list[dict[str, Any]] = []  # the anchoring layer's "cannot tell apart" events
+        self._awaited: set[str] = set()  # the world's events a route stop has waited for
         self._grounding = Grounding(GroundingConfig.from_yaml(grounding_file))
         self._store = open_knowledge_base("ros:///merlin2")
         self._session = MissionSession(
@@ -168,37 +205,71 @@ class MissionDemoNode(Node):
         self._session.wait_until_ready()
         self._initial_truth = self._truth()
         waypoints = [waypoint.name for waypoint in self._grounding.config.waypoints]
+        wanted = list(self._mission.explore) if self._mission.explore is not None else waypoints
         missions: list[tuple[str, bool, str]] = []
         # Aries is satisficing: asked for every room at once, it may explore the room the robot
         # stands in last, after a drive back to it. Looking around here first is one plain step.
         here = self._robot_place()
-        if here in waypoints:
+        if here in wanted:
             look = self._session.run([Proposition("explored", (here,), is_goal=True)], f"look around the {here}",
                                      EXPLORE_ACTIONS)
             missions.append((f"look around the {here}", look.succeeded, look.reason))
-        rest = [w for w in waypoints if w != here]
-        explore = self._session.run(
-            [Proposition("explored", (w,), is_goal=True) for w in rest], "explore the house", EXPLORE_ACTIONS)
-        missions.append(("explore the house", explore.succeeded, explore.reason))
-        if all(ok for _, ok, _ in missions) and self._away_from in waypoints:  # leave, so the world may move the mug
-            away = self._session.run(
-                [Proposition("robot_at", (self._away_from,), is_goal=True)], f"go to the {self._away_from}",
-                EXPLORE_ACTIONS)
-            missions.append((f"go to the {self._away_from}", away.succeeded, away.reason))
-        symbol = self._identify_target()
-        if not all(ok for _, ok, _ in missions) or symbol is None:
-            return self._finish(missions, symbol or "", found=False)
-        start = next((obj.position for obj in self._initial_truth if obj.id == self._target), None)
-        self._say(f"waiting for the world to move the {self._target.replace('_', ' ')} while the robot is away")
-        deadline = time.monotonic() + self._move_timeout
-        while time.monotonic() < deadline and self._target_position() == start:
-            time.sleep(0.5)
-        moved = self._target_position() != start
-        self._say(f"the {self._target.replace('_', ' ')} was moved" if moved else "the world did not move it")
+        rest = [w for w in wanted if w != here]
+        if rest and all(ok for _, ok, _ in missions):
+            explore = self._session.run(
+                [Proposition("explored", (w,), is_goal=True) for w in rest], "explore the house", EXPLORE_ACTIONS)
+            missions.append(("explore the house", explore.succeeded, explore.reason))
+        explored = all(ok for _, ok, _ in missions)
+        symbol = self._identify_target() if explored else None
+        if symbol is None:
+            why = "the target was not anchored while exploring" if explored else "exploring failed"
+            return self._finish(missions, "", found=False, fetch=None, why=why)
+        changed = True
+        for stop in self._mission.route:
+            if stop.go_to is not None and stop.go_to != self._robot_place():
+                away = self._session.run(
+                    [Proposition("robot_at", (stop.go_to,), is_goal=True)], f"go to the {stop.go_to}",
+                    EXPLORE_ACTIONS)
+                missions.append((f"go to the {stop.go_to}", away.succeeded, away.reason))
+                if not away.succeeded:
+                    return self._finish(missions, symbol, found=False, fetch=None, why=f"going to {stop.go_to} failed")
+            changed = self._wait_for_events(stop.wait_for) and changed
         name = f"find the {self._target.replace('_', ' ')} ({symbol}) and go to it"
         fetch = self._session.run([Proposition("robot_near", (symbol,), is_goal=True)], name, FETCH_ACTIONS)
         missions.append((name, fetch.succeeded, f"{fetch.reason}; {fetch.replans} replan(s)"))
-        return self._finish(missions, symbol, found=fetch.succeeded and moved)
+        return self._finish(missions, symbol, found=fetch.succeeded and changed, fetch=fetch)
+
+    def _wait_for_events(self, names: tuple[str, ...] | None) -> bool:
+        """Wait (up to ``move_timeout``) for the world to fire ``names`` (None: every event no
+        earlier stop waited for); say what happened. True when all of them fired."""
+        events = {event.name: event for event in self._world.scenario}
+        awaited = [name for name in events if name not in self._awaited] if names is None else list(names)
+        self._awaited.update(awaited)
+        if not awaited:
+            return True
+        unseen = not any(events[name].watched for name in awaited if name in events)
+        self._say(f"waiting for the world to {_and(_phrase(events.get(name), name) for name in awaited)}"
+                  + (" while the robot is away" if unseen else ""))
+        deadline = time.monotonic() + self._move_timeout
+        while time.monotonic() < deadline and not set(awaited) <= self._fired_events():
+            time.sleep(0.5)
+        fired = self._fired_events()
+        for name in awaited:
+            event = events.get(name)
+            if name in fired:
+                self._say(_happened(event, name))
+            else:
+                self._say("the world did not " + ("move it" if event is not None and event.action == "move"
+                                                  else _phrase(event, name)))
+        return set(awaited) <= fired
+
+    def _fired_events(self) -> set[str]:
+        """The names of the events the world has fired (from its ground_truth.json)."""
+        try:
+            data = json.loads((self._data / "ground_truth.json").read_text())
+        except (OSError, ValueError):
+            return set()
+        return {event["name"] for event in data.get("events", [])}
 
     def _robot_place(self) -> str | None:
         """The waypoint the knowledge base has the robot at (the behaviors node declares it)."""
@@ -208,49 +279,82 @@ class MissionDemoNode(Node):
 
     def _identify_target(self) -> str | None:
         """The symbol of the anchor where the target was put at the start: the user pointing at it
-        (the world may already have moved it: it does so as soon as the robot is away)."""
-        truth = [obj for obj in self._initial_truth if obj.id == self._target]
+        (the world may already have moved it: it does so as soon as the robot is away). Every other
+        object is named the same way, so the report can tell whose symbol went where."""
+        time.sleep(SETTLE_SECONDS)  # the last look's anchors are confirmed a moment after it ends
         with self._lock:
             anchors = [a for a in self._anchors if a.state == "confirmed"]
-        symbol = associate(truth, anchors).get(self._target) if truth else None
+        self._symbols_before = associate(self._initial_truth, anchors)
+        symbol = self._symbols_before.get(self._target)
         self._say(f"the {self._target.replace('_', ' ')} is anchored as {symbol}" if symbol
                   else f"the {self._target.replace('_', ' ')} was not anchored while exploring")
         return symbol
 
-    def _finish(self, missions: list[tuple[str, bool, str]], symbol: str, found: bool) -> bool:
-        time.sleep(1.5)  # let the last anchors and facts arrive
+    def _finish(self, missions: list[tuple[str, bool, str]], symbol: str, found: bool,
+                fetch: MissionResult | None, why: str = "") -> bool:
+        time.sleep(SETTLE_SECONDS)  # let the last anchors and facts arrive
         truth = self._truth()
         with self._lock:
             anchors = list(self._anchors)
+            views = list(self._anchor_views)
         target = next((obj for obj in truth if obj.id == self._target), None)
         kept = next((a for a in anchors if a.symbol == symbol), None)
         error = math.dist(target.position, kept.position) if target and kept else float("inf")
         outcome = DemoOutcome(missions, self._target, symbol, found and error <= 0.3, error,
                               time.monotonic() - self._started)
         facts = [p.objects for p in self._store.propositions.get_all() if p.predicate == "object_at" and not p.is_goal]
-        card = write_report(
+        claims = self._claims(symbol, target, views, facts, fetch, why)
+        card, verdict = write_report(
             self._folder, truth, anchors, [tuple(f) for f in facts], self._place_of, self._layers(), self._history,
-            f"{domain_from_store(self._store)}\n\n{problem_from_store(self._store)}", self._account, outcome)
+            f"{domain_from_store(self._store)}\n\n{problem_from_store(self._store)}", self._account, outcome,
+            claims)
         self._say(f"report written to {self._folder}: summary.md, scorecard.json, map.png, "
                   f"{self._frames} frames, knowledge.pddl")
         for line in card.to_markdown().splitlines():
             self._say(line)
         self._say(f"demo {'succeeded' if outcome.succeeded else 'failed'} in {outcome.seconds:.0f} s")
-        return outcome.succeeded
+        self._say(f"claims against the ground truth: {verdict.outcome}, {'right' if verdict.right else 'WRONG'}"
+                  + (f" ({'; '.join(verdict.problems)})" if verdict.problems else ""))
+        return verdict.right if self._judged else outcome.succeeded
+
+    def _claims(self, symbol: str, target: TrueObject | None, views: list, facts: list, fetch: MissionResult | None,
+                why: str) -> dict[str, Any]:
+        """The ``claims`` section of scorecard.json (what :func:`verdict.judge` reads)."""
+        claiming = [(record, seen) for record, seen, _ in views if record.state in CLAIMING_STATES]
+        places: dict[str, list[str]] = {}
+        for fact in facts:
+            places.setdefault(fact[0], []).append(fact[1])
+        with self._lock:
+            refers = {record.symbol: refers_to(record, seen, self._timeline) for record, seen in claiming}
+            ambiguous = list(self._ambiguous)
+        return {
+            "world": self._world.source,
+            "target": self._target,
+            "target_symbol": symbol,
+            "target_present": target is not None,
+            "target_place": self._place_of(target) if target is not None else None,
+            "symbols_before": dict(self._symbols_before),
+            "refers_to": refers,
+            "last_seen": {record.symbol: round(seen, 3) for record, seen in claiming},
+            "object_at": places,
+            "fetch": {"ran": fetch is not None, "succeeded": bool(fetch and fetch.succeeded),
+                      "reason": fetch.reason if fetch is not None else why},
+            "ambiguous": ambiguous,
+            "expect": self._mission.expect.as_dict(),
+        }
 
     # Helpers.
 
     def _truth(self) -> list[TrueObject]:
+        """The world's ground truth now; each version read is kept on the timeline."""
         try:
-            return truth_from_ground_truth(json.loads((self._data / "ground_truth.json").read_text()))
+            data = json.loads((self._data / "ground_truth.json").read_text())
         except (OSError, ValueError) as error:
             raise ConfigurationError(f"no ground truth from the world in {self._data}: {error}") from error
-
-    def _target_position(self) -> tuple[float, ...] | None:
-        try:
-            return next((o.position for o in self._truth() if o.id == self._target), None)
-        except ConfigurationError:
-            return None
+        truth = truth_from_ground_truth(data)
+        with self._lock:
+            self._timeline.record(float(data.get("stamp", time.time())), truth)
+        return truth
 
     def _place_of(self, obj: TrueObject) -> str | None:
         record = AnchorRecord("truth_probe", obj.class_name, obj.position)
@@ -280,6 +384,11 @@ class MissionDemoNode(Node):
     def _on_anchor_events(self, message: AnchorEventArray) -> None:
         for line in anchor_event_lines(self._words, message):
             self._say(line)
+        for event in message.events:
+            if event.kind == AnchorEvent.KIND_AMBIGUOUS:
+                with self._lock:
+                    self._ambiguous.append({"symbol": event.symbol, "stamp": _stamp(event),
+                                            "details": {item.key: item.value for item in event.details}})
 
     def _on_anchors(self, message: AnchorArray) -> None:
         records = [
@@ -298,8 +407,10 @@ class MissionDemoNode(Node):
             truth = self._truth()
         except ConfigurationError:
             return
+        now = time.time()  # the anchors' stamps are the camera's: the system clock
         with self._lock:
-            anchors = [a for a in self._anchors if a.state in ("confirmed", "missing")]
+            anchors = [record for record, seen, _ in self._anchor_views
+                       if record.state in CLAIMING_STATES and now - seen <= FRESH_SECONDS]
         self._history.record(associate(truth, anchors))
 
     def _on_robot_pose(self, message: PoseStamped) -> None:
@@ -368,6 +479,24 @@ class MissionDemoNode(Node):
         self._unsubscribe()
         self._store.close()
         super().destroy_node()
+
+
+def _phrase(event: ScenarioEvent | None, name: str) -> str:
+    """What an event does, as the running account says it ("move the red mug")."""
+    if event is None:
+        return f"fire {name}"
+    return f"{event.action} the {event.object_id.replace('_', ' ')}"
+
+
+def _happened(event: ScenarioEvent | None, name: str) -> str:
+    if event is None:
+        return f"{name} happened"
+    return f"the {event.object_id.replace('_', ' ')} was {_PAST.get(event.action, event.action)}"
+
+
+def _and(phrases: Any) -> str:
+    phrases = list(phrases)
+    return phrases[0] if len(phrases) == 1 else ", ".join(phrases[:-1]) + " and " + phrases[-1]
 
 
 class _Groundable:

@@ -153,18 +153,22 @@ def score(
     history: IdentityHistory | None = None,
     max_distance: float = 0.5,
     position_tolerance: float = 0.3,
+    record_final: bool = True,
 ) -> Scorecard:
     """Score the final anchors (and ``object_at`` facts, as (symbol, place)) against the truth.
 
     ``place_of`` gives the place the knowledge base should name for a true object (the same
     grounding the anchoring node uses); without it, facts are not scored. Anchors farther than
     ``max_distance`` from their object count as not anchoring it, so a wrong position shows up
-    as one object not anchored plus one anchor of nothing.
+    as one object not anchored plus one anchor of nothing. The final association is added to
+    ``history`` unless ``record_final`` is False (a caller whose history holds only anchors in
+    view: a stale anchor where another object now stands is not a switch).
     """
     claiming = [anchor for anchor in anchors if anchor.state in CLAIMING_STATES]
     association = associate(truth, claiming, max_distance)
     history = history if history is not None else IdentityHistory()
-    history.record(association)
+    if record_final:
+        history.record(association)
     by_symbol = {anchor.symbol: anchor for anchor in claiming}
     by_id = {obj.id: obj for obj in truth}
     errors = {

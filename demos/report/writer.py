@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -17,6 +17,7 @@ from merlin2_sailor_demos.report.scorecard import (
     score,
 )
 from merlin2_sailor_demos.report.top_down_map import MapLayers, draw_map
+from merlin2_sailor_demos.report.verdict import Verdict, judge
 
 
 @dataclass(frozen=True)
@@ -56,21 +57,28 @@ def write_report(
     pddl: str,
     account: Sequence[str],
     outcome: DemoOutcome,
-) -> Scorecard:
-    """Write every file of the report and return the scorecard."""
+    claims: Mapping[str, Any],
+) -> tuple[Scorecard, Verdict]:
+    """Write every file of the report; return the scorecard and the verdict on the ``claims``
+    (the section :func:`verdict.judge` reads; the identity history is the caller's, so the final
+    snapshot is not added to it here)."""
     folder.mkdir(parents=True, exist_ok=True)
-    card = score(truth, anchors, facts, place_of, history)
+    card = score(truth, anchors, facts, place_of, history, record_final=False)
     association = associate(truth, [a for a in anchors if a.state in ("confirmed", "missing")])
     draw_map(folder / "map.png", layers, truth, anchors, association,
              title=f"SAILOR mission demo: {len(anchors)} anchors, {len(truth)} objects")
     (folder / "knowledge.pddl").write_text(pddl)
     (folder / "account.log").write_text("\n".join(account) + "\n")
-    (folder / "scorecard.json").write_text(json.dumps(
-        {**card.to_dict(), "identity_history": history.symbols, "outcome": {
+    data: dict[str, Any] = {
+        **card.to_dict(), "identity_history": history.symbols, "outcome": {
             "succeeded": outcome.succeeded, "missions": [list(m) for m in outcome.missions],
             "target": outcome.target, "target_symbol": outcome.target_symbol,
             "target_found": outcome.target_found, "target_error_m": outcome.target_error,
-            "seconds": outcome.seconds}}, indent=2))
+            "seconds": outcome.seconds},
+        "claims": dict(claims)}
+    verdict = judge(data)
+    data["verdict"] = verdict.as_dict()
+    (folder / "scorecard.json").write_text(json.dumps(data, indent=2))
     lines = [
         "# SAILOR mission demo",
         "",
@@ -87,10 +95,15 @@ def write_report(
         "## Scorecard against the world's ground truth",
         "",
         card.to_markdown(),
+        "## The mission's claim against the ground truth",
+        "",
+        f"Outcome: {verdict.outcome}; **{'right' if verdict.right else 'wrong'}**"
+        + (": " + "; ".join(verdict.problems) + "." if verdict.problems else "."),
+        "",
         "Files: `map.png` (top-down: true objects in green, anchors as crosses), `frames/` (camera frames with "
         "the anchors' boxes and symbols), `knowledge.pddl` (the final knowledge base), `account.log`, "
         "`scorecard.json`.",
         "",
     ]
     (folder / "summary.md").write_text("\n".join(lines))
-    return card
+    return card, verdict

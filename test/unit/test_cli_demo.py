@@ -42,3 +42,83 @@ def test_a_file_is_not_an_output_folder(tmp_path) -> None:
 def test_the_command_is_registered_with_its_options() -> None:
     arguments = build_parser().parse_args(["demo", "--output", "somewhere", "--grace-period", "5"])
     assert str(arguments.output) == "somewhere" and arguments.grace_period == 5.0
+
+
+def test_the_scenario_options_are_registered() -> None:
+    parser = build_parser()
+    arguments = parser.parse_args(["demo", "--all-scenarios", "--seeds", "0,1,2", "--matcher", "network",
+                                   "--deadline", "200"])
+    assert arguments.all_scenarios and arguments.seeds == [0, 1, 2] and arguments.matcher == "network"
+    assert arguments.deadline == 200.0 and arguments.scenario is None
+    arguments = parser.parse_args(["demo", "--scenario", "removed", "--scenario", "swapped", "--seed", "4"])
+    assert arguments.scenario == ["removed", "swapped"] and arguments.seed == 4 and arguments.matcher is None
+
+
+@pytest.mark.parametrize("options", [
+    ["--scenario", "removed", "--all-scenarios"],
+    ["--seed", "1", "--seeds", "1,2"],
+    ["--seeds", "a,b"],
+    ["--seeds", "-1"],
+    ["--seed", "-3"],
+    ["--seeds", ","],
+    ["--matcher", "magic"],
+])
+def test_contradictory_or_bad_scenario_options_are_refused(options, capsys) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["demo", *options])
+
+
+def test_seeds_without_a_scenario_are_refused(tmp_path) -> None:
+    arguments = build_parser().parse_args(["demo", "--seeds", "1,2", "--output", str(tmp_path / "out")])
+    with pytest.raises(ConfigurationError, match="--seeds runs scenarios"):
+        arguments.run(arguments)
+    assert not (tmp_path / "out").exists()
+
+
+def test_list_scenarios_prints_each_with_its_description(capsys) -> None:
+    arguments = build_parser().parse_args(["demo", "--list-scenarios"])
+    assert arguments.run(arguments) == 0
+    lines = capsys.readouterr().out.splitlines()
+    names = [line.split()[0] for line in lines]
+    assert names[0] == "default" and {"removed", "swapped", "twin_moved", "crowded_shelf"} <= set(names)
+    assert all(len(line.split(maxsplit=1)) == 2 for line in lines)  # a description on every line
+
+
+def test_an_unknown_scenario_is_an_error_before_anything_runs(tmp_path) -> None:
+    arguments = build_parser().parse_args(["demo", "--scenario", "nope", "--output", str(tmp_path / "out")])
+    with pytest.raises(ConfigurationError, match="no scenario 'nope'"):
+        arguments.run(arguments)
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_scenario_folder_from_an_earlier_run_is_emptied_too(tmp_path) -> None:
+    (tmp_path / "runs" / "removed-seed0-rules").mkdir(parents=True)
+    (tmp_path / "scenarios.json").write_text("{}")
+    (tmp_path / "scenarios.md").write_text("old")
+    assert prepare_output(tmp_path) == tmp_path.resolve() and list(tmp_path.iterdir()) == []
+
+
+def test_a_run_gets_the_scenario_world_seed_matcher_data_folder_and_domain(tmp_path) -> None:
+    from merlin2_sailor_demos.scenario_runner import RunOptions, demo_launch, effective_parameter
+
+    spec = demo_launch(tmp_path, "worlds/scenarios/removed.yaml", RunOptions(seed=3, matcher="network", domain=42))
+    assert effective_parameter(spec, "world", "world_file") == "worlds/scenarios/removed.yaml"
+    assert effective_parameter(spec, "world", "seed") == 3
+    assert effective_parameter(spec, "mission_demo", "world_file") == "worlds/scenarios/removed.yaml"
+    assert effective_parameter(spec, "anchoring", "matcher") == "network"
+    assert effective_parameter(spec, "anchoring", "state_folder") == str(tmp_path / "anchoring")
+    assert effective_parameter(spec, "mission_demo", "report_folder") == str(tmp_path / "report")
+    assert spec.environment["ROS_DOMAIN_ID"] == "42" and spec.environment["SAILOR_DATA"] == str(tmp_path)
+    default = demo_launch(tmp_path, None, RunOptions())
+    # Without overrides the launch file's own values stand: the matcher comes from config/anchoring.yaml.
+    assert effective_parameter(default, "world", "world_file") == "worlds/house.yaml"
+    assert effective_parameter(default, "anchoring", "matcher") in ("rules", "network")
+    assert effective_parameter(default, "world", "seed") == 0  # config/world.yaml's
+    assert "ROS_DOMAIN_ID" not in default.environment
+
+
+def test_parameters_go_only_to_nodes_the_launch_has(tmp_path) -> None:
+    from merlin2_sailor_demos.scenario_runner import RunOptions, demo_launch, with_parameters
+
+    with pytest.raises(ConfigurationError, match=r"no node \['nobody'\]"):
+        with_parameters(demo_launch(tmp_path, None, RunOptions()), {"nobody": {"x": 1}})
