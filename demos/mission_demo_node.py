@@ -31,6 +31,7 @@ import json
 import math
 import threading
 import time
+import traceback
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -199,6 +200,10 @@ class MissionDemoNode(Node):
         except SailorError as error:
             self._say(f"the demo cannot go on: {error}")
             self.exit_code = 2
+        except Exception as error:  # a bug, or a planner engine that broke: end the demo, never hang it
+            self._say(f"the demo failed: {type(error).__name__}: {error}")
+            self.get_logger().error(traceback.format_exc())
+            self.exit_code = 1
 
     def _demo(self) -> bool:
         self._say(f"waiting for the graph; the report goes to {self._folder}")
