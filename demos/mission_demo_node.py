@@ -231,7 +231,7 @@ class MissionDemoNode(Node):
             return self._finish(missions, "", found=False, fetch=None, why=why)
         changed = True
         for stop in self._mission.route:
-            if stop.go_to is not None and stop.go_to != self._robot_place():
+            if stop.go_to is not None:  # even where the robot already is: the goal holds at once
                 away = self._session.run(
                     [Proposition("robot_at", (stop.go_to,), is_goal=True)], f"go to the {stop.go_to}",
                     EXPLORE_ACTIONS)
