@@ -258,7 +258,8 @@ class Dispatcher:
             return _Run(_Ending.CANCELED, f"cancelled during {step.step}")
         with self._lock:
             retraction = self._retraction
-        return _Run(_Ending.REPLAN, retraction or f"{step.step} {outcome}")
+        # The behaviour's own reason says why (a search that found only look-alikes, say): keep it.
+        return _Run(_Ending.REPLAN, retraction or f"{step.step} {outcome}" + (f": {reason}" if reason else ""))
 
     # Helpers.
 
