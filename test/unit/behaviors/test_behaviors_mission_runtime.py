@@ -172,11 +172,12 @@ def test_at_end_effects_are_not_applied_when_the_action_aborts(
     def abort(blackboard: Blackboard) -> str:
         calls.append(str(blackboard[PLAN_STEP_KEY]))
         assert robot_at(store) == []  # the at-start effect was applied while it ran
+        blackboard["reason"] = "the door is shut"
         return ABORT
 
     result = runner(store, planner, abort, max_replans=0).run(goal("b"))
     assert result.status is MissionStatus.FAILED
-    assert "gave up after 0 replan(s)" in result.reason and "aborted" in result.reason
+    assert "gave up after 0 replan(s)" in result.reason and "aborted: the door is shut" in result.reason
     assert calls == ["navigation(a, b)"]
     assert robot_at(store) == ["a"]  # no robot_at(b); the at-start deletion was undone
 
