@@ -5,7 +5,11 @@ the matching function M answers for a percept and an anchor, so it is answered b
 matcher (the learned one compares appearance; the rules only class, place and time): the newer
 anchor plays the percept, as it was when it first appeared (its first sighting's stamp, so the
 time feature measures the gap since the lost anchor was last seen), once per view in its
-appearance gallery, and the best view counts, as the gallery's nearest view does in matching.
+appearance gallery, each view against the lost anchor's nearest gallery view (as in matching), and
+the candidate's score is the mean over its views. Not the best view: the matching function is
+calibrated for one view, and the best of ten views of a green mug scored 0.74 against the lost
+blue mug where their median was 0.24; one lucky view is not evidence that the whole anchor is
+the lost object.
 
 For a search, where the lost object is sought is a disc rather than a point: the lost anchor is
 measured from that disc (anywhere in it counts as in place), as the matching table measures a
@@ -37,7 +41,8 @@ class SearchedDisc:
 def identity_scores(
     matcher: Matcher, candidates: Sequence[Anchor], lost: Anchor, disc: SearchedDisc | None = None
 ) -> np.ndarray:
-    """M(candidate as first perceived, lost) for each candidate: a (len(candidates),) array in [0, 1]."""
+    """M(candidate as first perceived, lost), averaged over the candidate's views, for each
+    candidate: a (len(candidates),) array in [0, 1]."""
     if not candidates:
         return np.zeros(0)
     percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance)
@@ -57,9 +62,8 @@ def identity_scores(
         with_appearance=matcher.uses_appearance,
     )
     per_view = matcher.score_pairs(features)
-    best = np.zeros(len(candidates))
-    np.maximum.at(best, owners, per_view)
-    return best
+    views = np.bincount(owners, minlength=len(candidates))
+    return np.bincount(owners, weights=per_view, minlength=len(candidates)) / views
 
 
 def _candidates_as_percepts(candidates: Sequence[Anchor], with_views: bool) -> tuple[PerceptColumns, np.ndarray]:

@@ -4,7 +4,13 @@ For a percept p and an anchor a the paper's M reads: same class (bool), the two 
 appearance, the L2 distance of the positions, a scale factor of the sizes and the time between
 them. They are encoded as the public implementation encodes them, except time:
 
-- distance: ``exp(-d)`` in (0, 1], 1 at the same place;
+- distance: ``exp(-d)`` in (0, 1], 1 at the same place, where ``d`` is the *footprint distance*:
+  the distance between the centres less what a large object's extent explains (see
+  :func:`extent_slack`). The public implementation feeds the plain distance; but the centre of a
+  view is the middle of the part the camera saw, so two views of one television or bicycle are
+  centred up to half its footprint apart, and a network fed the plain distance takes them for
+  two objects (measured on a tour of the demo's house: of the 234 true pairs the version-1
+  network rejected, 73 were under 0.1 m apart by footprint and over 0.2 m by centre);
 - scale: ``sum_i min(s_p_i, s_a_i) / sum_i max(s_p_i, s_a_i)`` in [0, 1], 1 for the same size;
 - time: the original ``2 / (1 + exp(|dt|))`` is below 0.01 after 5.3 s, so an object seen a
   minute ago and one seen an hour ago look the same to the network. Here it is
@@ -13,7 +19,14 @@ them. They are encoded as the public implementation encodes them, except time:
 - appearance: the element-wise L1 difference ``|f_p - f_a|`` of the frozen backbone's features,
   the siamese branch's input. An anchor keeps a gallery of recent features; the gallery entry
   nearest the percept (smallest L1 norm) is used, so an object is recognised from whichever side
-  it was last seen.
+  it was last seen. An embedding may end with the crop's colour histogram
+  (:mod:`merlin2_sailor.perception.colour_histogram`); its part of the difference is carried
+  along, and the network reads it as a colour similarity of its own.
+
+- searched: 1 when the anchor is being searched for (an expectation with a radius): its distance
+  is then measured from the searched disc, so anywhere in it is "here" and the place says
+  nothing; the network must know, or it takes the green mug in the room searched for the red
+  mug sought (in the house, same class and same place otherwise almost always mean the same object).
 
 An anchor with an expected location (an action's predicted effect) is measured from whichever of
 its expected and last perceived positions is nearer the percept: if the action failed and the
@@ -37,8 +50,10 @@ from merlin2_sailor.anchoring.gallery import from_bfloat16_bits
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
-#: Version of the encoding above; bump it whenever an encoding changes.
-FEATURE_ENCODING_VERSION = 1
+#: Version of the encoding above; bump it whenever an encoding changes. 2: the distance score is
+#: that of the footprint distance (1: of the plain distance), and the searched feature is new;
+#: 3: embeddings end with the crop's colour histogram, compared as a feature of its own.
+FEATURE_ENCODING_VERSION = 3
 
 #: Pairs whose appearance is compared at once; bounds each (pairs, D) temporary to ~5 MB.
 APPEARANCE_CHUNK_PAIRS = 1024
@@ -59,8 +74,7 @@ class FeatureConfig:
 #: centres. A larger object's centre moves with the view (the near end of a bicycle seen end-on, a
 #: television half out of the picture), by up to half of what exceeds this, so that much distance
 #: between a percept and an anchor of it is forgiven in ``PairFeatures.footprint_distance`` (see
-#: :func:`extent_slack`), which the rule matcher scores. The network keeps the plain distance it
-#: was trained on.
+#: :func:`extent_slack`), which both matchers score (the network as ``distance_score``).
 SMALL_OBJECT_EXTENT = 0.3
 
 
@@ -187,10 +201,11 @@ class PairFeatures:
     same_class: np.ndarray  # (K,) bool
     distance: np.ndarray  # (K,) metres
     footprint_distance: np.ndarray  # (K,) metres, less what a large object's extent explains
-    distance_score: np.ndarray  # (K,) exp(-d)
+    distance_score: np.ndarray  # (K,) exp(-footprint_distance)
     scale: np.ndarray  # (K,)
     time_difference: np.ndarray  # (K,) seconds, percept stamp minus anchor last seen
     time_score: np.ndarray  # (K,)
+    searched: np.ndarray  # (K,) bool: the anchor is searched for, its distance measured from the disc
     appearance_known: np.ndarray  # (K,) bool
     appearance_distance: np.ndarray  # (K,) L1 norm of appearance_difference, NaN where unknown
     appearance_difference: np.ndarray | None  # (K, D) float32
@@ -211,8 +226,10 @@ def pair_features(
     rows = np.asarray(rows, dtype=np.intp)
     columns = np.asarray(columns, dtype=np.intp)
     distance = np.linalg.norm(percepts.positions[rows] - anchors.positions[columns], axis=1)
+    searched = np.zeros(len(rows), dtype=bool)
     if anchors.search_radii is not None:  # anywhere in a searched disc is as good as its centre
         distance = np.maximum(distance - anchors.search_radii[columns], 0.0)
+        searched = anchors.search_radii[columns] > 0.0
     if anchors.perceived_positions is not None:
         perceived_distance = np.linalg.norm(percepts.positions[rows] - anchors.perceived_positions[columns], axis=1)
         distance = np.minimum(distance, perceived_distance)
@@ -240,10 +257,11 @@ def pair_features(
         same_class=percepts.class_names[rows] == anchors.class_names[columns],
         distance=distance,
         footprint_distance=footprint_distance,
-        distance_score=encode_distance(distance),
+        distance_score=encode_distance(footprint_distance),
         scale=scale_factor(percepts.sizes[rows], anchors.sizes[columns]),
         time_difference=time_difference,
         time_score=encode_time(time_difference, config.time_scale),
+        searched=searched,
         appearance_known=known,
         appearance_distance=appearance_distance,
         appearance_difference=difference,

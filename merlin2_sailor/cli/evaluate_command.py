@@ -7,9 +7,11 @@ and over the look-alike pairs (same class, near). Then each scene is replayed th
 anchoring layer with each matcher and the symbols are scored against the ground truth (ID
 switches, IDF1, via motmetrics). Text on stdout; with ``--output``, a confusion-matrix PNG and
 a JSON of every number. ``--source`` evaluates on a public data set's split instead (see
-``sailor train``). Both matchers and the anchoring layer are built from the anchoring node's
-settings (config/anchoring.yaml; ``--launch``, ``--params``, ``--set`` as for ``sailor replay``),
-by name through the matcher registry, so the figures are the deployed system's.
+``sailor train``). ``--world FILE`` tours a simulated house with each matcher instead
+(:mod:`.world_evaluation`): duplicate anchors and identity switches against the world's truth.
+Both matchers and the anchoring layer are built from the anchoring node's settings
+(config/anchoring.yaml; ``--launch``, ``--params``, ``--set`` as for ``sailor replay``), by name
+through the matcher registry, so the figures are the deployed system's.
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ from dataclasses import asdict, replace
 from pathlib import Path
 
 from merlin2_sailor.cli.anchoring_settings import add_settings_arguments, settings_from_arguments
-from merlin2_sailor.cli.train_command import SOURCE_HELP, embedding_cache, pair_source
+from merlin2_sailor.cli.train_command import DEFAULT_SCENES, DEFAULT_SOURCE, SOURCE_HELP, embedding_cache, pair_source
+from merlin2_sailor.cli.world_evaluation import add_world_arguments, run_world
 
 #: The matchers compared, each built from the same settings, by name.
 COMPARED_MATCHERS = ("network", "rules")
@@ -36,10 +39,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--weights", default="", metavar="PATH",
                         help="weights file (default: the parameter files' weights, else the ones shipped in "
                              "merlin2_sailor/models)")
-    parser.add_argument("--source", default="generated", metavar="SPEC", help=SOURCE_HELP)
+    parser.add_argument("--source", default=DEFAULT_SOURCE, metavar="SPEC", help=SOURCE_HELP)
     parser.add_argument("--split", default="test",
                         help="split to evaluate on (default test; a public data set also has 'all')")
-    parser.add_argument("--scenes", type=int, default=30, metavar="N", help="scenes of the split (default 30)")
+    parser.add_argument("--scenes", type=int, default=None, metavar="N",
+                        help="scenes of the split (default 10 houses, 30 generated scenes)")
     parser.add_argument("--first", type=int, default=0, metavar="I", help="first scene index (default 0)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated source (default 0)")
     parser.add_argument("--output", default="", metavar="DIR", help="write confusion.png and metrics.json here")
@@ -49,11 +53,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-cache", action="store_true", help="keep embeddings in memory only")
     parser.add_argument("--darknet", default="", metavar="DIR", help="darknet photo folder")
     parser.add_argument("--no-darknet", action="store_true", help="use scikit-image's photos only")
+    add_world_arguments(parser)
     add_settings_arguments(parser)
     parser.set_defaults(run=run)
 
 
 def run(arguments: argparse.Namespace) -> int:
+    if arguments.world:
+        return run_world(arguments, COMPARED_MATCHERS)
+    if arguments.scenes is None:
+        arguments.scenes = DEFAULT_SCENES.get(arguments.source, DEFAULT_SCENES["generated"])[2]
     from merlin2_sailor.anchoring.matcher_registry import create_matcher
     from merlin2_sailor.anchoring.settings import parameter_values
     from merlin2_sailor.models import default_weights_path
@@ -82,9 +91,14 @@ def run(arguments: argparse.Namespace) -> int:
     pairs = {name: evaluate_pairs(factory(), pair_set.chunks(), cache, threshold) for name, factory in matchers.items()}
     table = {name: result.all_pairs for name, result in pairs.items()}
     table.update({f"{name} look-alike": result.look_alike for name, result in pairs.items()})
+    table.update({f"{name} partial view": result.partial for name, result in pairs.items()})
+    table.update({f"{name} searched": result.searched for name, result in pairs.items() if result.searched.total})
+    table.update({f"{name} replaced": result.replaced for name, result in pairs.items() if result.replaced.total})
     print(f"weights {weights}; split {arguments.split!r}, scenes {arguments.first}.."
           f"{arguments.first + arguments.scenes - 1}, seed {arguments.seed}, threshold {threshold:g}\n")
-    print("pairs (Algorithm 3, every pair; look-alike = same class, nearer than 1 m)")
+    print("pairs (Algorithm 3, every pair; look-alike = same class, nearer than 1 m; partial view = either "
+          "side cut by the image's edge or an occluder; searched = extra pairs measured from a searched disc, "
+          "replaced = extra pairs of another object of the class where the anchor stood: only appearance tells)")
     print(format_table(table))
     print()
     for name, result in pairs.items():

@@ -1,5 +1,10 @@
 """``sailor train``: train the matching network on pairs of the generated source.
 
+The default source, ``houses``, is tours of generated houses rendered by the simulated world
+(:mod:`merlin2_sailor_demos.identity.house_source`): the crops, partial views and measured sizes
+the robot's camera produces. ``generated`` is the older source of real photo regions with
+per-view changes (:mod:`merlin2_sailor.training.generated_scenes`), no renderer involved.
+
 Steps: generate the train and validation scenes (lazily, from the seed), embed every crop once
 (cached under ``--cache``, so a second run embeds nothing), train with Adam (lr 0.001) on the
 class-balanced training pairs, validate on every validation pair each epoch, keep the best epoch.
@@ -19,7 +24,11 @@ from pathlib import Path
 from merlin2_sailor.training.source_registry import SOURCE_FORMS
 
 DEFAULT_OUTPUT = "matching_network.pt"
-SOURCE_HELP = f"pairs from: generated (default), {SOURCE_FORMS}"
+SOURCE_HELP = f"pairs from: houses (default: tours of generated houses), generated (photo regions), {SOURCE_FORMS}"
+#: The source ``--source`` defaults to, and the scenes per split each built-in source defaults to
+#: (train, validation, test): a house is a whole tour (~300 crops), a generated scene ~100 crops.
+DEFAULT_SOURCE = "houses"
+DEFAULT_SCENES = {"houses": (32, 8, 10), "generated": (120, 16, 30)}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -30,15 +39,18 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--output", default=DEFAULT_OUTPUT, metavar="PATH",
                         help=f"weights file to write (default {DEFAULT_OUTPUT}); PATH.json and PATH_loss.png beside it")
-    parser.add_argument("--source", default="generated", metavar="SPEC", help=SOURCE_HELP)
+    parser.add_argument("--source", default=DEFAULT_SOURCE, metavar="SPEC", help=SOURCE_HELP)
     parser.add_argument("--seed", type=int, default=0, help="seed of the generated source and of training (default 0)")
-    parser.add_argument("--train-scenes", type=int, default=120, metavar="N", help="training scenes (default 120)")
-    parser.add_argument("--validation-scenes", type=int, default=16, metavar="N",
-                        help="validation scenes (default 16)")
-    parser.add_argument("--epochs", type=int, default=8, help="epochs (default 8)")
+    parser.add_argument("--train-scenes", type=int, default=None, metavar="N",
+                        help="training scenes (default 32 houses, 120 generated scenes)")
+    parser.add_argument("--validation-scenes", type=int, default=None, metavar="N",
+                        help="validation scenes (default 8 houses, 16 generated scenes)")
+    parser.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainingConfig's, 3)")
     parser.add_argument("--batch-size", type=int, default=256, help="pairs per batch (default 256)")
     parser.add_argument("--learning-rate", type=float, default=0.001,
                         help="Adam learning rate (default 0.001, the paper's)")
+    parser.add_argument("--positive-weight", type=float, default=None, metavar="W",
+                        help="how much more a missed true pair costs than a wrong one (default: TrainingConfig's, 8)")
     parser.add_argument("--balance", type=float, default=2.0, metavar="RATIO",
                         help="different-class pairs kept per positive pair in training; a negative value keeps "
                              "every pair (default 2)")
@@ -64,18 +76,23 @@ def run(arguments: argparse.Namespace) -> int:
 
     started = time.perf_counter()
     source = pair_source(arguments)
-    sizes = SplitSizes(train=scene_count(source, TRAIN, arguments.train_scenes),
-                       validation=scene_count(source, VALIDATION, arguments.validation_scenes), test=0)
+    default_train, default_validation, _ = DEFAULT_SCENES.get(arguments.source, DEFAULT_SCENES["generated"])
+    sizes = SplitSizes(train=scene_count(source, TRAIN, _given(arguments.train_scenes, default_train)),
+                       validation=scene_count(source, VALIDATION,
+                                              _given(arguments.validation_scenes, default_validation)), test=0)
     balance = None if arguments.balance < 0 else arguments.balance
     train_pairs = PairDatasetConfig(different_class_per_positive=balance, seed=arguments.seed)
     validation_pairs = PairDatasetConfig(seed=arguments.seed)
     train_set = GeneratedPairSet(source, TRAIN, sizes.train, train_pairs)
     validation_set = GeneratedPairSet(source, VALIDATION, sizes.validation, validation_pairs)
-    training = TrainingConfig(epochs=arguments.epochs, batch_size=arguments.batch_size,
-                              learning_rate=arguments.learning_rate, seed=arguments.seed, device=arguments.device)
-    metadata = NetworkMetadata(time_scale=arguments.time_scale)
-
-    cache = embedding_cache(arguments, metadata.backbone)
+    given = {name: value for name, value in (("epochs", arguments.epochs),
+                                             ("positive_weight", arguments.positive_weight)) if value is not None}
+    training = TrainingConfig(batch_size=arguments.batch_size, learning_rate=arguments.learning_rate,
+                              seed=arguments.seed, device=arguments.device, **given)
+    cache = embedding_cache(arguments, NetworkMetadata().backbone)
+    # The network reads the embeddings the cache's embedder makes, colour histogram included.
+    metadata = NetworkMetadata(time_scale=arguments.time_scale, feature_dimension=cache.embedder.feature_dimension,
+                               colour_bins=cache.embedder.colour_bins)
     embedded = train_set.embed(cache) + validation_set.embed(cache)
     embedding_seconds = time.perf_counter() - started
     print(f"crops: {len(cache)} cached, {embedded} embedded now ({embedding_seconds:.1f} s)")
@@ -120,13 +137,32 @@ def generated_source(arguments: argparse.Namespace):  # type: ignore[no-untyped-
         seed=arguments.seed, use_darknet=not arguments.no_darknet, darknet_folder=arguments.darknet))
 
 
+def house_source(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
+    """The house source the arguments describe; rendered scenes are cached beside the embeddings."""
+    from merlin2_sailor.training.generated_dataset import default_cache_folder
+    from merlin2_sailor_demos.identity.generated_houses import HouseGeneratorConfig
+    from merlin2_sailor_demos.identity.house_source import HouseSource, HouseSourceConfig
+
+    config = HouseSourceConfig(seed=arguments.seed, houses=HouseGeneratorConfig(use_darknet=not arguments.no_darknet),
+                               darknet_folder=arguments.darknet)
+    folder = None if arguments.no_cache else (
+        Path(arguments.cache) if arguments.cache else default_cache_folder().parent) / "houses"
+    return HouseSource(config, folder)
+
+
 def pair_source(arguments: argparse.Namespace):  # type: ignore[no-untyped-def]
-    """The source ``--source`` names: the generated one, or a public data set's adapter."""
+    """The source ``--source`` names: the houses, the generated one, or a public data set's adapter."""
+    if arguments.source == "houses":
+        return house_source(arguments)
     if arguments.source == "generated":
         return generated_source(arguments)
     from merlin2_sailor.training.source_registry import open_source
 
     return open_source(arguments.source)
+
+
+def _given(value: int | None, default: int) -> int:
+    return default if value is None else value
 
 
 def scene_count(source, split: str, requested: int) -> int:  # type: ignore[no-untyped-def]
@@ -135,10 +171,12 @@ def scene_count(source, split: str, requested: int) -> int:  # type: ignore[no-u
 
 
 def embedding_cache(arguments: argparse.Namespace, backbone: str):  # type: ignore[no-untyped-def]
-    """The embedding cache the arguments describe, with the backbone's crop embedder."""
+    """The embedding cache the arguments describe, with the backbone's crop embedder; its
+    namespace is the embedder's name, so embeddings of another make are never mixed in."""
     from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
     from merlin2_sailor.training.embedding_cache import EmbeddingCache
     from merlin2_sailor.training.generated_dataset import default_cache_folder
 
     folder = None if arguments.no_cache else (arguments.cache or default_cache_folder())
-    return EmbeddingCache(CropEmbedder(EmbeddingConfig(backbone=backbone)), backbone, folder)
+    embedder = CropEmbedder(EmbeddingConfig(backbone=backbone))
+    return EmbeddingCache(embedder, embedder.name, folder)

@@ -22,6 +22,9 @@ from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.training.generated_scenes import Observation
 from merlin2_sailor.training.progress import progress_bar
 
+#: New rows are persisted in shards of about this many (see :meth:`EmbeddingCache.ensure`).
+SHARD_ROWS = 4096
+
 
 class EmbeddingCache:
     """Embeddings by crop id; ``backbone_crops`` counts the crops this instance sent to the backbone."""
@@ -59,28 +62,52 @@ class EmbeddingCache:
         description: str = "embedding crops",
         total: int | None = None,
     ) -> int:
-        """Embed every observation's crop not cached yet; return how many were embedded."""
-        missing: dict[str, Observation] = {}
-        for observation in observations:
-            if observation.crop_id not in self._rows:
-                missing.setdefault(observation.crop_id, observation)
-        if not missing:
-            return 0
+        """Embed every observation's crop not cached yet; return how many were embedded.
+
+        Streaming: observations are read once, in order, and each batch of ``batch_crops``
+        missing crops is rendered and embedded as soon as it is full, so a source that renders
+        its crops scene by scene (and keeps only the current scene's) is asked for each crop
+        while its scene is at hand. New rows are written as a shard every
+        :data:`SHARD_ROWS` rows and at the end, so an interrupted run keeps most of its work.
+        """
         ids: list[str] = []
         blocks: list[np.ndarray] = []
-        pending = list(missing.values())
-        with progress_bar(total=len(pending), description=description, unit="crop") as bar:
-            for start in range(0, len(pending), self.batch_crops):
-                batch = pending[start : start + self.batch_crops]
-                crops = [render(observation) for observation in batch]
+        pending: list[Observation] = []
+        queued: set[str] = set()
+        embedded = 0
+
+        def commit() -> None:
+            if ids:
+                embeddings = np.concatenate(blocks)
+                self._add(ids, embeddings)
+                self._persist(ids, embeddings)
+                ids.clear()
+                blocks.clear()
+
+        with progress_bar(total=total, description=description, unit="crop") as bar:
+
+            def flush() -> None:
+                crops = [render(observation) for observation in pending]
                 blocks.append(np.asarray(self.embedder.embed(crops), dtype=np.float32))
                 self.backbone_crops += len(crops)
-                ids += [observation.crop_id for observation in batch]
-                bar.update(len(batch))
-        embeddings = np.concatenate(blocks)
-        self._add(ids, embeddings)
-        self._persist(ids, embeddings)
-        return len(ids)
+                ids.extend(observation.crop_id for observation in pending)
+                bar.update(len(pending))
+                pending.clear()
+                if len(ids) >= SHARD_ROWS:
+                    commit()
+
+            for observation in observations:
+                if observation.crop_id in self._rows or observation.crop_id in queued:
+                    continue
+                queued.add(observation.crop_id)
+                pending.append(observation)
+                embedded += 1
+                if len(pending) >= self.batch_crops:
+                    flush()
+            if pending:
+                flush()
+        commit()
+        return embedded
 
     def lookup(self, crop_ids: Sequence[str] | np.ndarray) -> np.ndarray:
         """(K, D) float32 embeddings of ``crop_ids``, in order."""

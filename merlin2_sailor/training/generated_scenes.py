@@ -129,6 +129,13 @@ class Observation:
     ``instance`` is the ground-truth identity (unique within a scene); ``twin`` says the instance
     shares its photo region with another of its class; ``crop_id`` names the crop everywhere
     (embedding cache, pair records).
+
+    A source that knows more says so in the keyword-only fields: ``partial`` (the view is cut by
+    the image's edge or an occluder, as :mod:`merlin2_sailor.anchoring.partial_view` tells), and
+    the anchor of this instance as the anchoring layer would hold it once it has fused this
+    observation: ``anchor_position``, ``anchor_size`` and ``gallery`` (crop ids of its appearance
+    gallery, newest last). When they are None / empty, the anchor is this observation itself,
+    as in the paper's Algorithm 3.
     """
 
     crop_id: str
@@ -142,6 +149,10 @@ class Observation:
     twin: bool
     region: Region
     view: ViewChange
+    partial: bool = field(default=False, kw_only=True)
+    anchor_position: np.ndarray | None = field(default=None, kw_only=True)
+    anchor_size: np.ndarray | None = field(default=None, kw_only=True)
+    gallery: tuple[str, ...] = field(default=(), kw_only=True)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -24,16 +24,23 @@ def chunk_features(chunk: PairChunk, matcher: Matcher, cache: EmbeddingCache | N
     if matcher.uses_appearance:
         if cache is None:
             raise ConfigurationError("A matcher that uses appearance needs an embedding cache of the crops.")
-        embeddings = (cache.lookup(chunk.percept_crop_ids), cache.lookup(chunk.anchor_crop_ids))
+        embeddings = chunk.embeddings(cache.lookup)
     return chunk.features(matcher.feature_config, embeddings)
 
 
 @dataclass(slots=True)
 class PairEvaluation:
-    """Confusion counts over every pair and over the look-alike pairs (same class, near)."""
+    """Confusion counts over every pair of Algorithm 3, over its look-alike pairs (same class,
+    near) and its pairs where either side is a partial view (cut by the image's edge or an
+    occluder; only a source that renders whole frames, such as the house source, knows); and,
+    apart, over the searched pairs and the replaced pairs (:mod:`.pair_dataset`: appearance alone
+    must tell)."""
 
     all_pairs: ConfusionCounts = field(default_factory=ConfusionCounts)
     look_alike: ConfusionCounts = field(default_factory=ConfusionCounts)
+    partial: ConfusionCounts = field(default_factory=ConfusionCounts)
+    searched: ConfusionCounts = field(default_factory=ConfusionCounts)
+    replaced: ConfusionCounts = field(default_factory=ConfusionCounts)
 
 
 def evaluate_pairs(
@@ -43,7 +50,10 @@ def evaluate_pairs(
     result = PairEvaluation()
     for chunk in chunks:
         scores = matcher.score_pairs(chunk_features(chunk, matcher, cache))
-        result.all_pairs += ConfusionCounts.from_scores(chunk.labels, scores, threshold)
-        mask = chunk.look_alike
-        result.look_alike += ConfusionCounts.from_scores(chunk.labels[mask], scores[mask], threshold)
+        paper = ~(chunk.searched | chunk.replaced)
+        subsets = (("all_pairs", paper), ("look_alike", chunk.look_alike & paper), ("partial", chunk.partial & paper),
+                   ("searched", chunk.searched), ("replaced", chunk.replaced))
+        for subset, mask in subsets:
+            counts = ConfusionCounts.from_scores(chunk.labels[mask], scores[mask], threshold)
+            setattr(result, subset, getattr(result, subset) + counts)
     return result

@@ -124,3 +124,31 @@ def test_mixed_embedding_sizes_are_refused(maker):
     second = dataclasses.replace(maker.percept(KITCHEN[1], 0.0), embedding=np.zeros(5, dtype=np.float32))
     with pytest.raises(InvalidInputError, match="different sizes"):
         PerceptColumns.from_percepts([first, second])
+
+
+def _columns_at(offset: float, size: tuple[float, float, float]) -> tuple[PerceptColumns, AnchorColumns]:
+    """A percept ``offset`` metres along x from an anchor, both of ``size``, no appearance."""
+    percepts = PerceptColumns(
+        class_names=np.array(["tv"], dtype=object), positions=np.array([[offset, 0.0, 0.5]]),
+        sizes=np.array([size]), stamps=np.array([1.0]), tracker_ids=np.array([""], dtype=object),
+        embeddings=None, has_embedding=np.zeros(1, dtype=bool),
+    )
+    anchors = AnchorColumns(
+        class_names=np.array(["tv"], dtype=object), positions=np.array([[0.0, 0.0, 0.5]]), sizes=np.array([size]),
+        last_seen=np.array([0.0]), tracker_ids=np.array([""], dtype=object), galleries=None,
+        gallery_lengths=np.zeros(1, dtype=np.intp),
+    )
+    return percepts, anchors
+
+
+def test_the_distance_score_forgives_what_a_large_objects_extent_explains():
+    # A 1 m television seen in part is centred up to half its footprint beyond 0.3 m from its
+    # whole view's centre: 0.3 m off scores as the same place; a mug 0.3 m off does not.
+    tv = pair_features(*_columns_at(0.3, (0.1, 1.0, 0.6)), [0], [0], FeatureConfig(), False)
+    assert tv.distance[0] == pytest.approx(0.3) and tv.footprint_distance[0] == pytest.approx(0.0)
+    assert tv.distance_score[0] == pytest.approx(1.0)
+    farther = pair_features(*_columns_at(0.6, (0.1, 1.0, 0.6)), [0], [0], FeatureConfig(), False)
+    assert farther.distance_score[0] == pytest.approx(math.exp(-(0.6 - 0.35)))
+    mug = pair_features(*_columns_at(0.3, (0.1, 0.1, 0.1)), [0], [0], FeatureConfig(), False)
+    assert mug.footprint_distance[0] == pytest.approx(0.3)
+    assert mug.distance_score[0] == pytest.approx(math.exp(-0.3))

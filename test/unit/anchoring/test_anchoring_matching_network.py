@@ -38,10 +38,17 @@ DIMENSION = 32  # the synthetic embeddings' size; the real backbones give 1280 o
 @pytest.fixture
 def network() -> MatchingNetwork:
     torch.manual_seed(0)
-    return MatchingNetwork(NetworkMetadata(backbone="synthetic", feature_dimension=DIMENSION, time_scale=10.0)).eval()
+    return MatchingNetwork(
+        NetworkMetadata(backbone="synthetic", feature_dimension=DIMENSION, colour_bins=0, time_scale=10.0)
+    ).eval()
+
+
+COLOUR_BINS = 42  # a colour descriptor: the histograms of a crop's centre and surround
 
 
 def random_inputs(count: int, dimension: int = DIMENSION):
+    """Forward's inputs: same class, the backbone part of the difference, distance, scale, time,
+    searched, colour similarity."""
     generator = torch.Generator().manual_seed(1)
     return (
         torch.randint(0, 2, (count,), generator=generator).float(),
@@ -49,18 +56,33 @@ def random_inputs(count: int, dimension: int = DIMENSION):
         torch.rand(count, generator=generator),
         torch.rand(count, generator=generator),
         torch.rand(count, generator=generator),
+        torch.randint(0, 2, (count,), generator=generator).float(),
+        torch.rand(count, 2, generator=generator),
     )
 
 
-def test_architecture_has_the_published_sizes():
-    network = MatchingNetwork()  # EfficientNet-Lite0 features
-    assert network.siamese[0].in_features == 1280 and network.siamese[0].out_features == 512
-    assert network.siamese_branch[0].in_features == 512 and network.siamese_branch[0].out_features == 256
-    assert network.merge[0].in_features == 1280 and network.merge[0].out_features == 256
+def test_architecture_has_the_published_structure_with_the_default_sizes():
+    network = MatchingNetwork()  # EfficientNet-Lite0 features + colour, S = 256, B = 64, (C1, C2) = (256, 64)
+    assert network.metadata.feature_dimension == 1280 + 42 and network.metadata.colour_bins == 42
+    assert network.siamese[0].in_features == 1280 and network.siamese[0].out_features == 256
+    assert network.siamese_branch[0].in_features == 256 and network.siamese_branch[0].out_features == 64
+    for branch in (network.same_class_branch, network.distance_branch, network.scale_branch, network.time_branch,
+                   network.search_branch):
+        assert (branch[0].in_features, branch[0].out_features) == (1, 64)
+    assert (network.colour_branch[0].in_features, network.colour_branch[0].out_features) == (2, 64)
+    assert network.merge[0].in_features == 7 * 64 and network.merge[0].out_features == 64
     layers = [m for m in network.classifier if isinstance(m, torch.nn.Linear)]
-    assert [(layer.in_features, layer.out_features) for layer in layers] == [(256, 1024), (1024, 256), (256, 1)]
+    assert [(layer.in_features, layer.out_features) for layer in layers] == [(64, 256), (256, 64), (64, 1)]
     assert isinstance(network.classifier[0], torch.nn.Dropout) and network.classifier[0].p == 0.5
-    assert MatchingNetwork(NetworkMetadata(backbone="resnet18", feature_dimension=512)).siamese[0].in_features == 512
+    resnet = NetworkMetadata(backbone="resnet18", feature_dimension=512 + 42)
+    assert MatchingNetwork(resnet).siamese[0].in_features == 512
+
+
+def test_the_public_implementations_sizes_remain_available():
+    published = MatchingNetwork(NetworkMetadata(siamese_units=512, branch_units=256, classifier_units=(1024, 256)))
+    assert published.siamese[0].out_features == 512 and published.merge[0].in_features == 7 * 256
+    layers = [m for m in published.classifier if isinstance(m, torch.nn.Linear)]
+    assert [(layer.in_features, layer.out_features) for layer in layers] == [(256, 1024), (1024, 256), (256, 1)]
 
 
 def test_forward_is_batched_and_returns_logits(network):
@@ -86,6 +108,49 @@ def test_network_is_trainable(network):
         optimiser.step()
         losses.append(loss.item())
     assert losses[-1] < 0.5 * losses[0]
+
+
+def test_the_network_can_learn_what_only_colour_tells(network):
+    network.train()
+    inputs = random_inputs(128)
+    labels = (inputs[6][:, 1] > 0.5).float()  # only the surround's colour similarity decides
+    optimiser = torch.optim.Adam(network.parameters(), lr=3e-3)
+    loss_function = torch.nn.BCEWithLogitsLoss()
+    for _ in range(150):
+        optimiser.zero_grad()
+        loss_function(network(*inputs), labels).backward()
+        optimiser.step()
+    network.eval()
+    accuracy = ((network(*inputs) > 0).float() == labels).float().mean().item()
+    assert accuracy > 0.9
+
+
+def test_the_colour_descriptor_at_the_end_of_an_embedding_is_read_as_two_similarities(maker):
+    from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
+    from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
+
+    def descriptor(centre_bin: int, surround_bin: int) -> np.ndarray:
+        """Histograms of 21 bins, all of the centre's pixels in one bin, all the surround's in another."""
+        values = np.zeros(COLOUR_BINS, dtype=np.float32)
+        values[centre_bin] = values[21 + surround_bin] = 1.0
+        return values
+
+    torch.manual_seed(0)
+    network = MatchingNetwork(NetworkMetadata(backbone="synthetic", feature_dimension=DIMENSION + COLOUR_BINS))
+    network.eval()
+    (anchor,) = anchors_with_galleries(maker, KITCHEN[:1])
+    shape = from_bfloat16_bits(anchor.gallery[0])  # the maker's embeddings stand for the backbone's part
+    anchor.gallery = to_bfloat16_bits(np.concatenate([shape, descriptor(3, 5)])[None].astype(np.float32))
+    percepts = [dataclasses.replace(maker.percept(KITCHEN[0], 1.0),
+                                    embedding=np.concatenate([shape, descriptor(*bins)]).astype(np.float32))
+                for bins in ((3, 5), (3, 9), (7, 9))]
+    features = pair_features(PerceptColumns.from_percepts(percepts), AnchorColumns.from_anchors([anchor]),
+                             np.arange(3), np.zeros(3, dtype=np.intp), network.metadata.feature_config, True)
+    inputs = network.inputs_from(features)
+    assert inputs[1].shape == (3, DIMENSION)  # the siamese branch sees the backbone's part only
+    # Histogram intersections of (centre, surround): same colours, another surround, nothing shared.
+    np.testing.assert_allclose(inputs[6].numpy(), [[1.0, 1.0], [1.0, 0.0], [0.0, 0.0]], atol=1e-6)
+    assert len(set(network.probabilities(*inputs).tolist())) == 3  # and the score depends on them
 
 
 def test_weights_round_trip_with_metadata(network, tmp_path):
@@ -233,5 +298,5 @@ def test_real_backbone_features_fill_the_galleries(maker):
     percept = dataclasses.replace(maker.percept(KITCHEN[0], 0.0, with_embedding=False), crop=crop)
     anchoring.process([percept], None, 0.0)
     (anchor,) = anchoring.anchors
-    assert anchor.gallery.shape == (1, 1280)
+    assert anchor.gallery.shape == (1, 1280 + 42)  # the backbone's features, then the colour descriptor
     np.testing.assert_allclose(from_bfloat16_bits(anchor.gallery[0]), embedder.embed([crop])[0], rtol=1e-2, atol=1e-3)

@@ -39,9 +39,11 @@ def colour_embedder() -> ColourEmbedder:
 
 
 def observation(
-    instance: int, sample: int, class_name: str = "cup", position=(0.0, 0.0, 0.0), stamp=None
+    instance: int, sample: int, class_name: str = "cup", position=(0.0, 0.0, 0.0), stamp=None, twin: bool = False,
+    **known,
 ) -> Observation:
-    """A hand-made observation (region and view are placeholders: never rendered)."""
+    """A hand-made observation (region and view are placeholders: never rendered); ``known``: the
+    keyword-only fields a source that knows more fills (partial, anchor_position, ...)."""
     return Observation(
         crop_id=f"hand/{sample}/{instance}",
         instance=instance,
@@ -51,9 +53,10 @@ def observation(
         position=np.asarray(position, dtype=np.float64),
         size=np.full(3, 0.2),
         depth=2.0,
-        twin=False,
+        twin=twin,
         region=Region(0, 0.0, 0.0, 10.0, 10.0),
         view=ViewChange(tuple([0.0] * 8), 0.0, 1.0, 0.0, 0.0, 0.0, 0, (16, 16)),
+        **known,
     )
 
 

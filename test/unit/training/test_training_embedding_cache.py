@@ -54,3 +54,24 @@ def test_unknown_crops_and_bad_namespaces_give_clear_errors(colour_embedder) -> 
         cache.lookup(["nobody"])
     with pytest.raises(ConfigurationError, match="namespace"):
         EmbeddingCache(colour_embedder, "a/b")
+
+
+
+def test_crops_are_asked_for_while_their_scene_is_at_hand(colour_embedder, tmp_path) -> None:
+    # A source that keeps only its last scenes' crops (the house source renders a whole tour to
+    # make them) must be asked for each crop before more scenes are made: the cache streams.
+    made: list[int] = []
+
+    def scenes():  # noqa: ANN202
+        for index in range(4):
+            made.append(index)
+            yield hand_scene([[observation(i, 10 * index + s) for i in range(3)] for s in range(2)], f"hand/{index}")
+
+    def render(item) -> np.ndarray:  # noqa: ANN001
+        scene = item.sample // 10
+        assert scene >= made[-1] - 1, f"crop of scene {scene} asked for after scenes {made} were made"
+        return _render(item)
+
+    cache = EmbeddingCache(colour_embedder, "colour", tmp_path, batch_crops=4)
+    assert cache.ensure((o for scene in scenes() for o in scene.observations), render) == 24
+    assert len(list((tmp_path / "colour").glob("shard-*.npz"))) == 1

@@ -1,0 +1,64 @@
+"""Anchor against anchor: a candidate is scored over all its views, never by its luckiest one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
+from merlin2_sailor.anchoring.features import FeatureConfig, PairFeatures
+from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.contract.percept import BoundingBox2D, Percept
+
+
+class AppearanceOnly(Matcher):
+    """1 for a view identical to the lost anchor's nearest one, falling with the L1 distance;
+    records the distances it was asked about."""
+
+    uses_appearance = True
+
+    def __init__(self) -> None:
+        self.distances: list[np.ndarray] = []
+
+    @property
+    def feature_config(self) -> FeatureConfig:
+        return FeatureConfig()
+
+    def score_pairs(self, features: PairFeatures) -> np.ndarray:
+        self.distances.append(features.distance)
+        return np.exp(-features.appearance_distance)
+
+
+def anchor(symbol: str, views: list[list[float]], position=(0.0, 0.0, 0.8), stamp: float = 0.0) -> Anchor:
+    percept = Percept(class_name="cup", score=0.9, box=BoundingBox2D(50.0, 50.0, 20.0, 20.0),
+                      position=np.asarray(position, dtype=float), size=np.full(3, 0.1), stamp=stamp)
+    made = Anchor.from_percept(symbol, percept, None, FusionConfig())
+    made.gallery = to_bfloat16_bits(np.asarray(views, dtype=np.float32))
+    return made
+
+
+def test_a_candidate_scores_the_mean_of_its_views_not_its_best():
+    lost = anchor("cup_1", [[1.0, 0.0, 0.0, 0.0]])
+    lucky = anchor("cup_2", [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 4.0, 0.0], [0.0, 0.0, 0.0, 4.0]], stamp=5.0)
+    steady = anchor("cup_3", [[1.0, 0.5, 0.0, 0.0], [1.0, 0.0, 0.5, 0.0]], stamp=5.0)
+    scores = identity_scores(AppearanceOnly(), [lucky, steady], lost)
+    # lucky: one identical view (1.0) and two far ones (exp(-5)); steady: two views 0.5 away.
+    assert scores[0] == pytest.approx((1.0 + 2 * np.exp(-5.0)) / 3, rel=1e-3)
+    assert scores[1] == pytest.approx(np.exp(-0.5), rel=1e-2)
+    assert scores[1] > scores[0]
+
+
+def test_a_search_measures_the_lost_anchor_from_the_searched_disc():
+    lost = anchor("cup_1", [[1.0, 0.0]], position=(0.0, 0.0, 0.8))
+    candidate = anchor("cup_2", [[1.0, 0.0]], position=(5.0, 0.0, 0.8), stamp=5.0)
+    matcher = AppearanceOnly()
+    identity_scores(matcher, [candidate], lost)
+    identity_scores(matcher, [candidate], lost, SearchedDisc(np.array([5.5, 0.0, 0.8]), 1.0))
+    assert matcher.distances[0][0] == pytest.approx(5.0) and matcher.distances[1][0] == pytest.approx(0.0)
+
+
+def test_no_candidates_give_no_scores():
+    assert identity_scores(AppearanceOnly(), [], anchor("cup_1", [[1.0]])).shape == (0,)
