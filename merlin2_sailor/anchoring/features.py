@@ -19,7 +19,7 @@ them. They are encoded as the public implementation encodes them, except time:
 - appearance: the element-wise L1 difference ``|f_p - f_a|`` of the frozen backbone's features,
   the siamese branch's input. An anchor keeps a gallery of recent features; the gallery entry
   nearest the percept (smallest L1 norm) is used, so an object is recognised from whichever side
-  it was last seen. An embedding may end with the crop's colour histogram
+  it was last seen. An embedding may end with the crop's colour descriptor
   (:mod:`merlin2_sailor.perception.colour_histogram`); its part of the difference is carried
   along, and the network reads it as a colour similarity of its own.
 
@@ -52,7 +52,8 @@ from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
 #: Version of the encoding above; bump it whenever an encoding changes. 2: the distance score is
 #: that of the footprint distance (1: of the plain distance), and the searched feature is new;
-#: 3: embeddings end with the crop's colour histogram, compared as a feature of its own.
+#: 3: embeddings end with the crop's colour descriptor (centre and surround histograms), compared
+#: as a feature of its own.
 FEATURE_ENCODING_VERSION = 3
 
 #: Pairs whose appearance is compared at once; bounds each (pairs, D) temporary to ~5 MB.

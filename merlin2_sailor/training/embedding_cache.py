@@ -6,8 +6,9 @@ CPU), so each crop goes through it exactly once. :meth:`EmbeddingCache.ensure` e
 not cached yet, in batches, and writes them as one new shard ``<folder>/<namespace>/shard-N.npz``
 (arrays ``ids`` and ``embeddings``); a later run reads the shards back and embeds nothing.
 
-``namespace`` names the backbone: features of two backbones must never mix. Crop ids of the
-generated source embed the source's fingerprint, so a changed generator never reuses stale rows.
+``namespace`` names what the embeddings hold (the embedder's name, e.g.
+``efficientnet_lite0+colour42``): features of two makes must never mix. Crop ids of the generated
+source embed the source's fingerprint, so a changed generator never reuses stale rows.
 """
 
 from __future__ import annotations
