@@ -2,9 +2,10 @@
 :class:`~merlin2_sailor_behaviors.actions.clients.NavigationPort`.
 
 One goal at a time from the calling (worker) thread; cancelling the behaviour cancels the goal on
-the server. A goal that runs past ``goal_timeout`` is cancelled and reported as failed. The robot
-pose comes from a ``PoseStamped`` topic (``robot_pose``, as the anchoring node reads it); a pose
-that is not finite is dropped with a warning.
+the server. A goal that runs past ``goal_timeout`` is cancelled and reported as failed; a result
+lost on the way is asked for again. The robot pose comes from a ``PoseStamped`` topic
+(``robot_pose``, as the anchoring node reads it); a pose that is not finite is dropped with a
+warning.
 """
 
 from __future__ import annotations
@@ -14,15 +15,15 @@ from collections.abc import Callable
 
 from action_msgs.msg import GoalStatus
 from geometry_msgs.msg import PoseStamped
-from rclpy.action import ActionClient
 from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
 
+from merlin2_sailor.ros.action_client import RaceFreeActionClient
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_behaviors.actions.clients import NavigationResult, NavigationStatus, Pose2D
 from merlin2_sailor_behaviors.actions.errors import BehaviorError
 from merlin2_sailor_behaviors.ros.conversions import planar_pose, pose_stamped
-from merlin2_sailor_behaviors.ros.waiting import WaitEnd, wait_for, wait_for_future
+from merlin2_sailor_behaviors.ros.waiting import WaitEnd, wait_for, wait_for_future, wait_for_goal_result
 from merlin2_sailor_interfaces.action import NavigateToPose
 
 STOPPING = NavigationResult(NavigationStatus.FAILED, "the behaviors node is shutting down")
@@ -47,7 +48,7 @@ class RosNavigationClient:
         self._frame_id = frame_id
         self._server_timeout = server_timeout
         self._goal_timeout = goal_timeout
-        self._client = ActionClient(node, NavigateToPose, action_name, callback_group=callback_group)
+        self._client = RaceFreeActionClient(node, NavigateToPose, action_name, callback_group=callback_group)
         namespace = node.get_namespace().rstrip("/")
         self._action_name = action_name if action_name.startswith("/") else f"{namespace}/{action_name}"
         self._pose: Pose2D | None = None
@@ -95,19 +96,24 @@ class RosNavigationClient:
         handle = sent.result()
         if not handle.accepted:
             return NavigationResult(NavigationStatus.FAILED, f"{self.action_name} rejected the goal")
-        result = handle.get_result_async()
-        end = wait_for_future(result, self._goal_timeout, self._stopping, should_cancel)
-        if end is not WaitEnd.DONE:
+        waited = wait_for_goal_result(handle, self._goal_timeout, self._stopping, should_cancel)
+        self._report_requeries(waited.requeries)
+        if waited.end is not WaitEnd.DONE:
             handle.cancel_goal_async()
-            if end is WaitEnd.STOPPING:
+            if waited.end is WaitEnd.STOPPING:
                 return STOPPING
-            if end is WaitEnd.TIMEOUT:
+            if waited.end is WaitEnd.TIMEOUT:
                 return NavigationResult(
                     NavigationStatus.FAILED, f"the robot did not arrive within {self._goal_timeout:g} s")
             # Cancelled: give the server a moment to stop the robot and say so.
-            wait_for_future(result, self._server_timeout, self._stopping)
+            self._report_requeries(wait_for_goal_result(handle, self._server_timeout, self._stopping).requeries)
             return NavigationResult(NavigationStatus.CANCELED)
-        return self._outcome(result.result(), should_cancel)
+        return self._outcome(waited.response, should_cancel)
+
+    def _report_requeries(self, requeries: int) -> None:
+        if requeries:
+            self._node.get_logger().warning(
+                f"a result of {self.action_name} was lost on the way; asked for it again ({requeries} time(s))")
 
     def _outcome(self, response: object, should_cancel: Callable[[], bool]) -> NavigationResult:
         status = getattr(response, "status", GoalStatus.STATUS_UNKNOWN)

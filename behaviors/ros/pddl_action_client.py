@@ -4,7 +4,10 @@ A :class:`PddlActionBehaviour` is a :data:`~merlin2_sailor_behaviors.planning.Be
 with the dispatcher's blackboard, it sends the step in ``blackboard[PLAN_STEP_KEY]`` (the objects
 in parameter order) to ``<prefix>/<action>`` and waits for the outcome; ``cancel_state()``
 cancels the goal. An outcome other than succeeded leaves the server's reason on the blackboard
-(``REASON_KEY``). The node it is given must be spun by another thread (an executor or a
+(``REASON_KEY``). Every wait is bounded: a step that runs past :func:`step_deadline` is
+cancelled and aborts (the dispatcher replans), and a result lost on the way is asked for again
+(:func:`~merlin2_sailor_behaviors.ros.waiting.wait_for_goal_result`). The node it is given must
+be spun by another thread (an executor or a
 :class:`~merlin2_sailor.ros.background_spinner.BackgroundSpinner`); :class:`RemoteBehaviours`
 brings its own.
 
@@ -26,15 +29,15 @@ from types import TracebackType
 from typing import Any
 
 import rclpy
-from rclpy.action import ActionClient
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 
 from merlin2_sailor.knowledge import KnowledgeBase
+from merlin2_sailor.ros.action_client import RaceFreeActionClient
 from merlin2_sailor.ros.background_spinner import BackgroundSpinner
 from merlin2_sailor_behaviors.actions.keys import PLAN_STEP_KEY, REASON_KEY
 from merlin2_sailor_behaviors.planning.plan import PlanStep
-from merlin2_sailor_behaviors.ros.waiting import WaitEnd, wait_for, wait_for_future
+from merlin2_sailor_behaviors.ros.waiting import WaitEnd, wait_for, wait_for_future, wait_for_goal_result
 from merlin2_sailor_behaviors.state_machines import ABORT, BASIC_OUTCOMES, CANCEL, Blackboard
 from merlin2_sailor_interfaces.action import RunPddlAction
 
@@ -43,6 +46,29 @@ DEFAULT_PREFIX = "/behaviors"
 
 SERVER_GONE_SECONDS = 3.0
 """How long a running step's server may be missing from the graph before the step aborts."""
+
+STEP_DEADLINE_FACTOR = 10.0
+"""A step may run this many times its PDDL duration (MERLIN2's planner plans with durations that
+are estimates, KANT's default 10 s for most actions) ..."""
+
+STEP_DEADLINE_MARGIN = 60.0
+"""... plus this many seconds, before it is cancelled and counts as failed, so that a behaviour
+that never ends (or a result that never comes) makes the dispatcher replan instead of waiting
+forever. An instantaneous action gets the margin alone."""
+
+
+def step_deadline(step: PlanStep, factor: float = STEP_DEADLINE_FACTOR, margin: float = STEP_DEADLINE_MARGIN) -> float:
+    """Seconds ``step`` may run before it is cancelled (see STEP_DEADLINE_FACTOR)."""
+    return margin + factor * (step.duration or 0.0)
+
+
+def describe_deadline(
+    step: PlanStep, factor: float = STEP_DEADLINE_FACTOR, margin: float = STEP_DEADLINE_MARGIN
+) -> str:
+    """How :func:`step_deadline` came to its figure, in words."""
+    if step.duration:
+        return f"{factor:g} x its PDDL duration of {step.duration:g} s + {margin:g} s"
+    return f"{margin:g} s for an instantaneous action"
 
 
 class PddlActionBehaviour:
@@ -55,12 +81,17 @@ class PddlActionBehaviour:
         server_name: str | None = None,
         server_timeout: float = 5.0,
         cancel_timeout: float = 10.0,
+        deadline_factor: float = STEP_DEADLINE_FACTOR,
+        deadline_margin: float = STEP_DEADLINE_MARGIN,
     ) -> None:
         self.action_name = action_name
         self.server_name = server_name or f"{DEFAULT_PREFIX}/{action_name}"
         self._server_timeout = server_timeout
         self._cancel_timeout = cancel_timeout
-        self._client = ActionClient(node, RunPddlAction, self.server_name, callback_group=ReentrantCallbackGroup())
+        self._deadline = (deadline_factor, deadline_margin)
+        self._client = RaceFreeActionClient(node, RunPddlAction, self.server_name,
+                                            callback_group=ReentrantCallbackGroup())
+        self._logger = node.get_logger()
         self._canceled = threading.Event()
         self._never = threading.Event()
         self.last_state = ""
@@ -92,20 +123,35 @@ class PddlActionBehaviour:
         handle = sent.result()
         if not handle.accepted:
             return _abort(blackboard, f"{self.server_name} rejected the goal {step}")
-        result = handle.get_result_async()
         server_gone = self._vanishing_server()
-        if wait_for_future(result, None, self._never, lambda: self._canceled.is_set() or server_gone()) \
-                is WaitEnd.CANCELED:
-            if not self._canceled.is_set():
-                return _abort(blackboard, f"{self.server_name} went away while running {step}")
+        deadline = step_deadline(step, *self._deadline)
+        waited = wait_for_goal_result(handle, deadline, self._never,
+                                      lambda: self._canceled.is_set() or server_gone())
+        self._report_requeries(step, waited.requeries)
+        if waited.end is WaitEnd.CANCELED and not self._canceled.is_set():
+            return _abort(blackboard, f"{self.server_name} went away while running {step}")
+        if waited.end is not WaitEnd.DONE:  # cancelled by the dispatcher, or past the step's deadline
+            if waited.end is WaitEnd.TIMEOUT:
+                self._logger.warning(f"{step} passed its deadline of {deadline:g} s; cancelling it")
             handle.cancel_goal_async()
-            if wait_for_future(result, self._cancel_timeout, self._never) is not WaitEnd.DONE:
+            stopped = wait_for_goal_result(handle, self._cancel_timeout, self._never)
+            self._report_requeries(step, stopped.requeries)
+            if waited.end is WaitEnd.TIMEOUT:
+                return _abort(blackboard, f"{step} did not end within its deadline of {deadline:g} s "
+                                          f"({describe_deadline(step, *self._deadline)}); it was cancelled")
+            if stopped.end is not WaitEnd.DONE:
                 return _abort(blackboard, f"{step} did not stop within {self._cancel_timeout:g} s of its cancel")
-        response = result.result().result
+            waited = stopped
+        response = waited.response.result
         outcome = response.outcome if response.outcome in BASIC_OUTCOMES else ABORT
         if outcome != BASIC_OUTCOMES[0]:
             blackboard[REASON_KEY] = response.message or f"{step} ended {response.outcome!r}"
         return outcome
+
+    def _report_requeries(self, step: PlanStep, requeries: int) -> None:
+        if requeries:
+            self._logger.warning(f"the result of {step} was lost on the way; asked for it again "
+                                 f"({requeries} time(s))")
 
     def _vanishing_server(self) -> Callable[[], bool]:
         """A check that turns true once the server has been gone for SERVER_GONE_SECONDS."""

@@ -12,6 +12,11 @@ each run in its own folder ``OUTPUT/runs/<scenario>-seed<N>-<matcher>/`` and DDS
 a deadline, judged against the world's ground truth; a progress line per run, then the table
 (also written as ``OUTPUT/scenarios.md`` and ``OUTPUT/scenarios.json``). Exit status 0 when every
 run was right.
+
+With ``--soak N`` it runs N runs of the default demo and the scenarios in turn, each with the next
+seed, to find what happens only now and then: the table, then the soak's summary (runs, right,
+wrong, hangs, crashes, lost results recovered, steps cancelled at their deadline, the slowest
+run; also ``OUTPUT/soak.md`` and ``OUTPUT/soak.json``). Exit status 0 when no run hung or crashed.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from merlin2_sailor.errors import ConfigurationError
 DEFAULT_OUTPUT = Path("reports") / "demo"
 #: What a demo run leaves in its output folder: the only entries it removes before a new run.
 DEMO_ENTRIES = ("report", "anchoring", "knowledge.db", "ground_truth.json", "runs", "scenarios.md",
-                "scenarios.json")
+                "scenarios.json", "soak.md", "soak.json")
 MATCHERS = ("rules", "network")
 #: Seconds a scenario run may take before it is stopped and counted as a hang (one takes 1-3 min).
 DEFAULT_DEADLINE = 420.0
@@ -59,6 +64,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     which.add_argument("--all-scenarios", action="store_true", help="run every scenario of the suite")
     which.add_argument("--list-scenarios", action="store_true",
                        help="list the scenarios with what each shows, and exit")
+    which.add_argument("--soak", type=_run_count, default=None, metavar="N",
+                       help="run N runs, the default demo and every scenario in turn, each with the next seed "
+                            "(from --seed's), and report hangs, wrong identities and the slowest run")
     seeds = parser.add_mutually_exclusive_group()
     seeds.add_argument("--seed", type=_seed, default=None, metavar="N",
                        help="seed of the world's randomness (odometry, depth noise, detector; default: "
@@ -83,6 +91,16 @@ def _seed(text: str) -> int:
     return seed
 
 
+def _run_count(text: str) -> int:
+    try:
+        count = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a number of runs must be a whole number, got {text!r}") from None
+    if count < 1:
+        raise argparse.ArgumentTypeError(f"a number of runs must be at least 1, got {count}")
+    return count
+
+
 def _seed_list(text: str) -> list[int]:
     seeds = [_seed(item.strip()) for item in text.split(",") if item.strip()]
     if not seeds:
@@ -93,7 +111,7 @@ def _seed_list(text: str) -> list[int]:
 def run(arguments: argparse.Namespace) -> int:
     if arguments.list_scenarios:
         return list_scenarios()
-    if arguments.scenario or arguments.all_scenarios:
+    if arguments.scenario or arguments.all_scenarios or arguments.soak:
         return run_scenarios(arguments)
     if arguments.seeds is not None:
         raise ConfigurationError("--seeds runs scenarios: give --scenario NAME or --all-scenarios too")
@@ -128,8 +146,10 @@ def run_default(arguments: argparse.Namespace) -> int:
 
 
 def run_scenarios(arguments: argparse.Namespace) -> int:
-    """Every requested scenario once per seed, one after another, then the table."""
-    from merlin2_sailor_demos.report.scenario_table import to_text, write_table
+    """Every requested scenario once per seed (or the soak's runs), one after another, then the
+    table (and the soak's summary)."""
+    from merlin2_sailor_demos.report.scenario_table import to_markdown, to_text, write_table
+    from merlin2_sailor_demos.report.soak_summary import SoakSummary, write_soak
     from merlin2_sailor_demos.scenario_runner import (
         ANCHORING_NODE,
         DOMAINS,
@@ -141,15 +161,21 @@ def run_scenarios(arguments: argparse.Namespace) -> int:
     )
     from merlin2_sailor_demos.scenarios import all_scenarios, find_scenario
 
-    entries = all_scenarios() if arguments.all_scenarios else [find_scenario(name) for name in arguments.scenario]
+    entries = all_scenarios() if arguments.all_scenarios or arguments.soak else [
+        find_scenario(name) for name in arguments.scenario]
+    if arguments.soak and arguments.seeds is not None:
+        raise ConfigurationError("--soak gives each run the next seed: give the first with --seed, not --seeds")
     if arguments.deadline <= 0:
         raise ConfigurationError(f"--deadline must be positive, got {arguments.deadline:g}")
     output = prepare_output(arguments.output)
     configured = demo_launch(output, None, RunOptions())  # what the launch's own configuration says
     matcher = arguments.matcher or str(effective_parameter(configured, ANCHORING_NODE, "matcher") or "rules")
     configured_seed = int(effective_parameter(configured, WORLD_NODE, "seed") or 0)
-    seeds = arguments.seeds or [arguments.seed if arguments.seed is not None else configured_seed]
-    plan = [(entry, seed) for entry in entries for seed in seeds]
+    first_seed = arguments.seed if arguments.seed is not None else configured_seed
+    if arguments.soak:
+        plan = [(entries[index % len(entries)], first_seed + index) for index in range(arguments.soak)]
+    else:
+        plan = [(entry, seed) for entry in entries for seed in (arguments.seeds or [first_seed])]
     stop = threading.Event()
     runs = []
     for index, (entry, seed) in enumerate(plan):
@@ -169,6 +195,12 @@ def run_scenarios(arguments: argparse.Namespace) -> int:
     print()
     print(to_text(runs), end="", flush=True)
     print(f"\nTable written to {markdown} and {data}", flush=True)
+    if arguments.soak:
+        summary = SoakSummary.of(runs)
+        soak_markdown, soak_data = write_soak(output, summary, to_markdown(runs))
+        print(f"\nSoak of {len(runs)} run(s):\n{summary.to_text()}Written to {soak_markdown} and {soak_data}",
+              flush=True)
+        return 0 if len(runs) == len(plan) and summary.hangs == 0 and summary.crashes == 0 else 1
     return 0 if len(runs) == len(plan) and all(done.right for done in runs) else 1
 
 

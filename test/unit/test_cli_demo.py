@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from merlin2_sailor.cli.demo_command import prepare_output
@@ -122,3 +124,44 @@ def test_parameters_go_only_to_nodes_the_launch_has(tmp_path) -> None:
 
     with pytest.raises(ConfigurationError, match=r"no node \['nobody'\]"):
         with_parameters(demo_launch(tmp_path, None, RunOptions()), {"nobody": {"x": 1}})
+
+
+@pytest.mark.parametrize("options", [["--soak", "0"], ["--soak", "x"], ["--soak", "3", "--all-scenarios"]])
+def test_bad_soak_options_are_refused(options) -> None:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["demo", *options])
+
+
+def test_a_soak_runs_the_demo_and_every_scenario_in_turn_each_with_the_next_seed(tmp_path, monkeypatch,
+                                                                                capsys) -> None:
+    from merlin2_sailor_demos import scenario_runner
+    from merlin2_sailor_demos.report.scenario_table import HANG, ScenarioRun
+    from merlin2_sailor_demos.report.verdict import Verdict
+    from merlin2_sailor_demos.scenarios import all_scenarios
+
+    ran = []
+
+    def fake_run(entry, folder, options, matcher, echo=None, stop=None):  # noqa: ANN001, ANN202
+        ran.append((entry.name, options.seed))
+        folder.mkdir(parents=True)
+        if len(ran) == 3:
+            (folder / "launch.log").write_text("[mission_demo] WARN: the result of explore(kitchen) was lost on the "
+                                               "way; asked for it again (1 time(s))\n")
+            return ScenarioRun(entry.name, options.seed, matcher, None, ending=HANG, wall_seconds=420.0,
+                               folder=str(folder))
+        return ScenarioRun(entry.name, options.seed, matcher, Verdict("found", True), wall_seconds=10.0 * len(ran),
+                           folder=str(folder))
+
+    monkeypatch.setattr(scenario_runner, "run_scenario", fake_run)
+    names = [entry.name for entry in all_scenarios()]
+    count = len(names) + 2
+    arguments = build_parser().parse_args(["demo", "--soak", str(count), "--seed", "5", "--output",
+                                           str(tmp_path / "out")])
+    assert arguments.run(arguments) == 1  # one run hung
+    assert ran == [(names[index % len(names)], 5 + index) for index in range(count)]
+    text = capsys.readouterr().out
+    assert "hangs (still running at the deadline)" in text
+    soak = json.loads((tmp_path / "out" / "soak.json").read_text())
+    assert (soak["runs"], soak["right"], soak["hangs"], soak["lost_results_recovered"]) == (count, count - 1, 1, 1)
+    assert soak["slowest"]["scenario"] == names[2]
+    assert (tmp_path / "out" / "soak.md").read_text().startswith("# Soak\n\n| figure | value |")
