@@ -3,6 +3,8 @@
 Crops come from a real photo (Debian darknet's dog.jpg) at the sizes a detector gives, and go
 through the whole path a percept's crop takes: resize to 224 px, ImageNet normalisation, the
 frozen EfficientNet-Lite0. One torch thread, as on a robot sharing its CPU. Nothing is asserted.
+This is torch's batching study; the runtime the nodes use by default (OpenVINO) is measured
+against torch by ``bench_inference.py``.
 
 Run: python bench/bench_embedding.py [number_of_crops] [--quick] [--json PATH]
 """
@@ -25,6 +27,7 @@ import torch
 from harness import script
 from harness.results import BenchmarkResult, Table
 
+from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
 
 PHOTO = "/usr/share/darknet/data/dog.jpg"
@@ -65,7 +68,7 @@ def run(quick: bool = False, crops: int = 0) -> BenchmarkResult:
     )
     per_crop = {}
     for batch_size in batch_sizes:
-        embedder = CropEmbedder(EmbeddingConfig(batch_size=batch_size))
+        embedder = CropEmbedder(EmbeddingConfig(batch_size=batch_size, inference=InferenceSettings(runtime="native")))
         embedder.embed(images[:2])  # warm-up: first calls allocate and pick kernels
         if batch_size == 1:
             elapsed = min(seconds(lambda e=embedder: [e.embed([crop]) for crop in images]) for _ in range(repeats))

@@ -38,12 +38,17 @@ COMMAND = "sailor bench"
 #: name -> (script in bench/, what it measures); the order they run in.
 BENCHMARKS = {
     "percepts": ("bench_percepts.py", "percept generation per frame (3D boxes + crops) vs per-pixel Python"),
-    "embedding": ("bench_embedding.py", "crop embedding per crop, batched vs one at a time"),
+    "embedding": ("bench_embedding.py", "crop embedding per crop in torch, batched vs one at a time"),
+    "inference": ("bench_inference.py", "embedding, detector and matching network on OpenVINO vs torch / OpenCV DNN, "
+                                        "and the anchoring service's memory on each"),
     "matching": ("bench_matching.py", "matching table vs anchors (100..10,000) and percepts (1..50) vs per pair"),
     "assignment": ("bench_assignment.py", "Hungarian vs greedy and brute force"),
     "knowledge_sync": ("bench_knowledge_sync.py", "knowledge-base sync, one batch vs one call per change"),
     "anchoring_scale": ("bench_anchoring_scale.py", "anchoring per frame and memory as far anchors pile up"),
     "pipeline": ("bench_pipeline.py", "end-to-end latency over DDS at 15 and 30 Hz, memory over a long run"),
+    "pipeline_detector": ("bench_pipeline_detector.py",
+                          "the whole pipeline with the real detector and the learned matcher at 15 and 30 Hz, "
+                          "new inference path (OpenVINO) vs old (OpenCV DNN + torch)"),
     "load": ("bench_load.py", "50 detections at 30 Hz then 90 Hz over DDS: memory, queues, drops"),
     "world_render": ("bench_world_render.py", "the simulated house's frame (render, depth, detections) vs 15 Hz"),
     "network_split": ("bench_network_split.py",
@@ -51,7 +56,7 @@ BENCHMARKS = {
                       "(needs network namespaces; skipped with the reason where they cannot be made)"),
 }
 #: Benchmarks that take --duration (their long phase) and write the nodes' output with --node-log.
-GRAPH_BENCHMARKS = ("pipeline", "load")
+GRAPH_BENCHMARKS = ("pipeline", "pipeline_detector", "load")
 ERROR_LINES = 60
 
 

@@ -102,4 +102,10 @@ if ! up_to_date package "$package_hash"; then
   mark_done package "$package_hash"
 fi
 
+# 5. The networks exported for the inference runtime (OpenVINO), so no node spends its first start
+#    converting them. Each export is named by a hash of its source: a second run exports nothing.
+say "exporting the networks for OpenVINO (first run: about a minute)"
+"$venv/bin/sailor" export-models > "$root/build/export-models.log" 2>&1 \
+  || { tail -n 20 "$root/build/export-models.log" >&2; die "exporting the models failed; the log is in build/export-models.log"; }
+
 say "ready: $venv ($("$python" --version))"

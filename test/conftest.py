@@ -28,6 +28,10 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
 os.environ.setdefault("ROS_LOG_DIR", tempfile.mkdtemp(prefix="sailor-test-ros-logs-"))
 os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "config" / "fastdds.xml"))
 os.environ.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
+# Exported models are named by a hash of what they were exported from, so the run may share the
+# user's model cache (set-up fills it): it cannot read a stale model. Fixed before HOME moves.
+os.environ.setdefault("SAILOR_MODEL_CACHE", str(Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+                                                / "merlin2_sailor" / "models"))
 # Nodes keep state under ~ (e.g. ~/.sailor/anchoring): tests must neither read a user's state
 # nor leave theirs behind, so this run gets a home of its own.
 os.environ["HOME"] = tempfile.mkdtemp(prefix="sailor-test-home-")

@@ -42,7 +42,7 @@ from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 
-from harness.scene import Scene, detections_of, make_scene
+from harness.scene import Scene, detections_of, load_photos, make_scene
 from merlin2_sailor.ros.conversions import array_to_image, camera_info_message, detections_to_message, pose_to_message
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_interfaces.msg import DetectionArray
@@ -74,8 +74,8 @@ class Phase:
 class FramePlayer:
     """Publishes one scene's messages with a fresh stamp each frame (messages built once)."""
 
-    def __init__(self, node: Node, scene: Scene, seed: int = 1) -> None:
-        self._node, self._scene = node, scene
+    def __init__(self, node: Node, scene: Scene, seed: int = 1, with_detector: bool = False) -> None:
+        self._node, self._scene, self._with_detector = node, scene, with_detector
         self._rng = np.random.default_rng(seed)
         self.info = node.create_publisher(CameraInfo, "color/camera_info", SENSOR_DATA)
         self.pose = node.create_publisher(PoseStamped, "camera_pose", SENSOR_DATA)
@@ -100,12 +100,15 @@ class FramePlayer:
         self.pose.publish(self._pose_message)
         self.depth.publish(self._depth_message)
         self.image.publish(self._image_message)
-        self.detections.publish(detections_to_message(detections_of(self._scene, self._rng), optical))
+        if not self._with_detector:  # else the detector node finds them in the image
+            self.detections.publish(detections_to_message(detections_of(self._scene, self._rng), optical))
 
     def graph_ready(self, percepts_subscribers: int) -> bool:
         """Everyone listening: the percept generator, the anchoring node and the benchmark's probe."""
         node = self._node
-        publishers = (self.info, self.pose, self.depth, self.image, self.detections)
+        publishers = (self.info, self.pose, self.depth, self.image)
+        if not self._with_detector:
+            publishers += (self.detections,)
         return (all(p.get_subscription_count() > 0 for p in publishers)
                 and node.count_subscribers(node.resolve_topic_name("percepts")) >= percepts_subscribers
                 and node.count_publishers(node.resolve_topic_name("anchors")) >= 1
@@ -154,6 +157,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--percepts-subscribers", type=int, default=2,
                         help="subscribers of 'percepts' to wait for (anchoring + the benchmark's probe)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--detector", action="store_true",
+                        help="publish no detections (the detector node finds them): objects show real photos")
     options = parser.parse_args(remove_ros_args(arguments)[1:])
 
     stop = threading.Event()
@@ -162,7 +167,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rclpy.init(args=arguments, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("frame_player")
     try:
-        player = FramePlayer(node, make_scene(options.objects, options.seed))
+        scene = make_scene(options.objects, options.seed, photos=load_photos() if options.detector else ())
+        player = FramePlayer(node, scene, with_detector=options.detector)
         deadline = time.monotonic() + GRAPH_TIMEOUT_SECONDS
         while not player.graph_ready(options.percepts_subscribers):
             if stop.is_set():

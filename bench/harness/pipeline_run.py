@@ -36,7 +36,7 @@ from merlin2_sailor.launcher.command import resolve_executable
 from merlin2_sailor.resources import config_file
 from merlin2_sailor.ros.background_spinner import BackgroundSpinner
 from merlin2_sailor.ros.qos import EVENTS
-from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
+from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, DetectionArray, PerceptArray
 
 PLAYER_SCRIPT = Path(__file__).resolve().parent / "frame_player.py"
 PLAYER_LABEL = "frame_player"
@@ -62,6 +62,16 @@ class PipelineConfig:
     report_period: float = 5.0  # seconds between two statistics lines of the percept generator
     drain_seconds: float = 1.5
     graph_timeout: float = 60.0  # how long the player waits for the graph before giving up
+    #: The real detector node between the camera and the percept generator (objects show real
+    #: photos), instead of ground-truth detections from the player.
+    detector: bool = False
+    #: Anchoring and detector parameters over the shipped configuration (e.g. the matcher, the runtime).
+    anchoring_parameters: tuple[tuple[str, object], ...] = ()
+    detector_parameters: tuple[tuple[str, object], ...] = ()
+
+    @property
+    def node_labels(self) -> tuple[str, ...]:
+        return NODE_LABELS + (("detector",) if self.detector else ())
 
     @property
     def playing_seconds(self) -> float:
@@ -81,6 +91,7 @@ class Recording:
     pids: dict[str, int]
     outcomes: list[dict[str, Any]]
     log: list[str] = field(default_factory=list)
+    detections: list[int] = field(default_factory=list)  # DetectionArray stamps, with the detector
 
     @property
     def ended_cleanly(self) -> bool:
@@ -124,6 +135,7 @@ class Probe:
         self.percepts: list[tuple[int, int, int]] = []
         self.anchors: list[tuple[int, int, int, int]] = []
         self.events: list[tuple[int, tuple[int, ...]]] = []
+        self.detections: list[int] = []  # header stamps of the detector's DetectionArrays (when it runs)
         self._spinner = BackgroundSpinner("bench-probe")
         node = self._spinner.add_node(
             rclpy.create_node("bench_probe", namespace=f"/{namespace}", context=self._spinner.context))
@@ -134,6 +146,10 @@ class Probe:
         node.create_subscription(PerceptArray, "percepts", self._on_percepts, deep_best_effort, raw=True)
         node.create_subscription(AnchorArray, "anchors", self._on_anchors, deep_latched)
         node.create_subscription(AnchorEventArray, "anchor_events", self._on_events, EVENTS)
+        node.create_subscription(DetectionArray, "detections", self._on_detections, deep_best_effort)
+
+    def _on_detections(self, message: DetectionArray) -> None:
+        self.detections.append(stamp_ns(message.header.stamp))
 
     def _on_percepts(self, raw: bytes) -> None:
         received = time.time_ns()
@@ -246,11 +262,16 @@ def launch_spec(config: PipelineConfig, folder: Path, frames_file: Path) -> Laun
                         "--drain", str(config.drain_seconds)]
     for phase in config.phases:
         player_arguments += ["--phase", phase.argument()]
-    nodes = (
+    if config.detector:
+        player_arguments.append("--detector")
+    detector = (NodeSpec("detector", namespace=namespace, parameters=(
+        config_file("detector.yaml"), dict(config.detector_parameters))),) if config.detector else ()
+    nodes = detector + (
         NodeSpec("knowledge_base", namespace=f"{namespace}/merlin2", parameters=(config_file("knowledge_base.yaml"),)),
         NodeSpec("anchoring", namespace=namespace, parameters=(
             config_file("anchoring.yaml"),
-            {"state_folder": str(folder / "anchoring"), "knowledge_base": f"ros:///{namespace}/merlin2"})),
+            {"state_folder": str(folder / "anchoring"), "knowledge_base": f"ros:///{namespace}/merlin2",
+             **dict(config.anchoring_parameters)})),
         NodeSpec("percept_generator", namespace=namespace, parameters=(
             config_file("percept_generator.yaml"), {"report_period": config.report_period})),
         # By name, so the launcher finds this venv's interpreter (a path would be resolved past its symlink).
@@ -280,7 +301,7 @@ def run_pipeline(config: PipelineConfig, echo: Echo = print) -> Recording:
         runner = threading.Thread(target=lambda: outcome.append(supervisor.run(duration=safety)),
                                   name="bench-launch", daemon=True)
         runner.start()
-        tokens = {label: resolve_executable(label) for label in NODE_LABELS}
+        tokens = {label: resolve_executable(label) for label in config.node_labels}
         tokens[PLAYER_LABEL] = str(PLAYER_SCRIPT)
         pids = find_pids(tokens, timeout=30.0)
         sampler = ResourceSampler({label: pid for label, pid in pids.items()}, config.sample_period)
@@ -302,7 +323,7 @@ def run_pipeline(config: PipelineConfig, echo: Echo = print) -> Recording:
             raise PipelineError(f"the pipeline did not run (no frames were played); the nodes said:\n{tail}")
         played = json.loads(frames_file.read_text())
     return Recording(config, played, probe.percepts, probe.anchors, probe.events, sampler.samples, pids, outcomes,
-                     log.lines)
+                     log.lines, probe.detections)
 
 
 def phases_of(specs: Sequence[tuple[str, float, float, float]]) -> tuple[Phase, ...]:

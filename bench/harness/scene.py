@@ -1,16 +1,21 @@
 """A synthetic RGB-D frame with N objects in view, and its ground-truth detections.
 
-The pipeline benchmarks feed the real nodes without a detector, so the frame only has to look
-like a camera's to the percept generator: a 640x480 colour image, a registered 16UC1 depth image
-in millimetres (what a RealSense publishes) with a few pixels missing, a back wall, and N textured
-objects at 1.5-3.5 m laid out on a grid so that none hides another. Detections are the objects'
+The pipeline benchmarks feed the real nodes, with or without the detector; without it the frame
+only has to look like a camera's to the percept generator; with it the objects show real photos
+(Debian darknet's dog, horses, people, ...) for the detector to find. A 640x480 colour image, a
+registered 16UC1 depth image in millimetres (what a RealSense publishes) with a few pixels
+missing, a back wall, and N textured objects at 1.5-3.5 m laid out on a grid so that none hides
+another. Detections are the objects'
 true boxes with a pixel of noise per frame, as a detector's boxes wobble. ROS-free.
 """
 
 from __future__ import annotations
 
 import math
+import os
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -45,8 +50,10 @@ class Scene:
     objects: tuple[SceneObject, ...]
 
 
-def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int = HEIGHT) -> Scene:
-    """``object_count`` objects on a grid filling the image, each 60 % of its cell."""
+def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int = HEIGHT,
+               photos: Sequence[np.ndarray] = ()) -> Scene:
+    """``object_count`` objects on a grid filling the image, each 60 % of its cell; with ``photos``
+    (RGB images), each object shows one of them, so that a real detector has real objects to find."""
     if object_count < 1:
         raise ValueError("a scene needs at least one object")
     rng = np.random.default_rng(seed)
@@ -65,9 +72,15 @@ def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int
         distance = rng.uniform(1500.0, 3500.0)
         depth[y_min:y_max, x_min:x_max] = (distance + rng.normal(0.0, 5.0, (y_max - y_min, x_max - x_min))).astype(
             np.uint16)
-        base = rng.integers(0, 256, 3)
-        texture = rng.integers(-40, 40, (y_max - y_min, x_max - x_min, 3))
-        color[y_min:y_max, x_min:x_max] = np.clip(base + texture, 0, 255).astype(np.uint8)
+        if photos:
+            import cv2
+
+            color[y_min:y_max, x_min:x_max] = cv2.resize(photos[index % len(photos)], (x_max - x_min, y_max - y_min),
+                                                         interpolation=cv2.INTER_AREA)
+        else:
+            base = rng.integers(0, 256, 3)
+            texture = rng.integers(-40, 40, (y_max - y_min, x_max - x_min, 3))
+            color[y_min:y_max, x_min:x_max] = np.clip(base + texture, 0, 255).astype(np.uint8)
         class_id = index % len(CLASS_NAMES)
         objects.append(SceneObject(class_id, CLASS_NAMES[class_id], box))
     depth[rng.random((height, width)) < MISSING_DEPTH_FRACTION] = 0
@@ -75,6 +88,19 @@ def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int
     intrinsics = CameraIntrinsics(fx=focal, fy=focal, cx=(width - 1) / 2.0, cy=(height - 1) / 2.0,
                                   width=width, height=height)
     return Scene(intrinsics, CAMERA_TO_WORLD, color, depth, tuple(objects))
+
+
+#: Real photos of COCO objects (Debian darknet; scripts/fetch_test_data.sh): what the detector finds.
+PHOTO_NAMES = ("dog", "horses", "person", "giraffe", "eagle", "kite")
+
+
+def load_photos() -> list[np.ndarray]:
+    """The darknet photos (RGB) from ``SAILOR_DARKNET_DATA``; none where they are missing."""
+    import cv2
+
+    folder = Path(os.environ.get("SAILOR_DARKNET_DATA") or "/usr/share/darknet/data")
+    images = [cv2.imread(str(folder / f"{name}.jpg")) for name in PHOTO_NAMES]
+    return [cv2.cvtColor(image, cv2.COLOR_BGR2RGB) for image in images if image is not None]
 
 
 def detections_of(scene: Scene, rng: np.random.Generator, noise: float = BOX_NOISE_PIXELS) -> list[Detection]:

@@ -36,7 +36,7 @@ _EXPORTS = MappingProxyType(
         "Matcher": "matcher",
         "MatchingNetwork": "matching_network",
         "NetworkMatcher": "matching_network",
-        "NetworkMetadata": "matching_network",
+        "NetworkMetadata": "network_inputs",
         "MatchingTable": "matching_table",
         "MatchingTableBuilder": "matching_table",
         "MatchingTableConfig": "matching_table",
@@ -62,8 +62,9 @@ if TYPE_CHECKING:
     from merlin2_sailor.anchoring.fusion import FusionConfig
     from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
     from merlin2_sailor.anchoring.matcher import Matcher
-    from merlin2_sailor.anchoring.matching_network import MatchingNetwork, NetworkMatcher, NetworkMetadata
+    from merlin2_sailor.anchoring.matching_network import MatchingNetwork, NetworkMatcher
     from merlin2_sailor.anchoring.matching_table import MatchingTable, MatchingTableBuilder, MatchingTableConfig
+    from merlin2_sailor.anchoring.network_inputs import NetworkMetadata
     from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
     from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
     from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig

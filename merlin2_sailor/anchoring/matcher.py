@@ -1,7 +1,8 @@
 """The matching function M behind one interface: ``score(percepts, anchors) -> (P, A) table``.
 
 Two implementations: :class:`~.rule_matcher.RuleMatcher` (hand-tuned, no appearance, no torch)
-and :class:`~.matching_network.NetworkMatcher` (the paper's network). Both score *pairs* from
+and the paper's network, run in torch (:class:`~.matching_network.NetworkMatcher`) or exported
+to OpenVINO (:class:`~.openvino_matcher.OpenVinoNetworkMatcher`). Both score *pairs* from
 :class:`~.features.PairFeatures`, so the matching table can compute features once, for the pairs
 that survive gating only, and hand them to whichever matcher is configured.
 """
@@ -23,6 +24,11 @@ class Matcher(ABC):
 
     #: Whether scores depend on appearance; if so, the matching table embeds crops it needs.
     uses_appearance: bool = False
+
+    @property
+    def threads(self) -> int:
+        """Threads the matcher's network runs with (0: no network, or it does not say)."""
+        return 0
 
     @property
     @abstractmethod

@@ -23,11 +23,13 @@ from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.matching_table import Embedder
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcherConfig
 from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.models import DEFAULT_BACKBONE
 from merlin2_sailor.plugins import PluginTable
 
-#: What to install when torch (the network and the crop embedder) is missing.
-TORCH_HINT = "Install torch and torchvision (scripts/setup.sh does), or choose the 'rules' matcher."
+#: What to install when the network's runtime is missing.
+TORCH_HINT = ("Install OpenVINO and torch (scripts/setup.sh does; torch only to export the models), "
+              "or choose the 'rules' matcher.")
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,13 +39,15 @@ class MatcherSettings:
     ``name``: a key of :data:`MATCHER_ENTRIES`; ``weights``: the network's weights file ("" for the
     shipped ones); ``backbone``: the crop backbone the weights were trained with, which the
     embedder runs; ``rules``: the rule matcher's tolerances, also the network's fallback for pairs
-    it cannot score (no embedding).
+    it cannot score (no embedding); ``inference``: the runtime, device and threads the network and
+    the crop backbone run with.
     """
 
     name: str = "rules"
     weights: str = ""
     backbone: str = DEFAULT_BACKBONE
     rules: RuleMatcherConfig = field(default_factory=RuleMatcherConfig)
+    inference: InferenceSettings = field(default_factory=InferenceSettings)
 
     def __post_init__(self) -> None:
         if self.name not in MATCHER_ENTRIES:
@@ -62,28 +66,39 @@ class MatcherEntry:
 
     target: str
     needs_embedder: bool
-    build: Callable[[Any, MatcherSettings], Matcher]
+    build: Callable[[Any, MatcherSettings, Callable[[str], None] | None], Matcher]
     hint: str = ""
 
 
-def _build_rules(matcher_class: Any, settings: MatcherSettings) -> Matcher:
+def _build_rules(matcher_class: Any, settings: MatcherSettings,
+                 report: Callable[[str], None] | None = None) -> Matcher:
     return matcher_class(settings.rules)
 
 
-def _build_network(matcher_class: Any, settings: MatcherSettings) -> Matcher:
-    from merlin2_sailor.anchoring.matching_network import NetworkMatcherConfig, load_network
+def _build_network(matcher_class: Any, settings: MatcherSettings,
+                   report: Callable[[str], None] | None = None) -> Matcher:
+    """The network on the configured runtime: exported and run by OpenVINO (no torch at run time
+    once exported), or in torch itself (``native``)."""
+    from merlin2_sailor.anchoring.network_inputs import NetworkMatcherConfig
     from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
     from merlin2_sailor.models import default_weights_path
 
     weights = Path(settings.weights).expanduser() if settings.weights else default_weights_path()
     # Pairs without an embedding are scored by the rules the deployment configured, not the defaults.
     fallback = NetworkMatcherConfig(fallback=RuleMatcher(settings.rules))
-    return matcher_class(load_network(weights, settings.backbone), fallback)
+    if settings.inference.runtime == "openvino":
+        from merlin2_sailor.anchoring.openvino_matcher import OpenVinoNetworkMatcher
+
+        return OpenVinoNetworkMatcher.from_weights(weights, settings.backbone, settings.inference, fallback, report)
+    from merlin2_sailor.anchoring.matching_network import NetworkMatcher, load_network
+
+    settings.inference.apply_to_torch()
+    return NetworkMatcher(load_network(weights, settings.backbone), fallback)
 
 
 MATCHER_ENTRIES: Mapping[str, MatcherEntry] = MappingProxyType({
     "rules": MatcherEntry("merlin2_sailor.anchoring.rule_matcher:RuleMatcher", False, _build_rules),
-    "network": MatcherEntry("merlin2_sailor.anchoring.matching_network:NetworkMatcher", True, _build_network,
+    "network": MatcherEntry("merlin2_sailor.anchoring.network_inputs:PairNetworkMatcher", True, _build_network,
                             TORCH_HINT),
 })
 
@@ -94,22 +109,23 @@ MATCHERS = PluginTable(
 )
 
 
-def create_matcher(settings: MatcherSettings) -> Matcher:
-    """The matcher ``settings.name`` names, built from ``settings`` (its module imported now)."""
-    return MATCHER_ENTRIES[settings.name].build(MATCHERS.load(settings.name), settings)
+def create_matcher(settings: MatcherSettings, report: Callable[[str], None] | None = None) -> Matcher:
+    """The matcher ``settings.name`` names, built from ``settings`` (its module imported now);
+    ``report`` hears what a node should log (a model exported, a device replaced by the CPU)."""
+    return MATCHER_ENTRIES[settings.name].build(MATCHERS.load(settings.name), settings, report)
 
 
-def create_embedder(settings: MatcherSettings) -> Embedder:
-    """The crop embedder running ``settings.backbone``; the backbone registry imports torch, and
-    says what to install when it is missing."""
+def create_embedder(settings: MatcherSettings, report: Callable[[str], None] | None = None) -> Embedder:
+    """The crop embedder running ``settings.backbone`` on ``settings.inference``'s runtime."""
     from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
 
-    return CropEmbedder(EmbeddingConfig(backbone=settings.backbone))
+    return CropEmbedder(EmbeddingConfig(backbone=settings.backbone, inference=settings.inference), report=report)
 
 
-def create_matching(settings: MatcherSettings, embed: bool = True) -> tuple[Matcher, Embedder | None]:
+def create_matching(settings: MatcherSettings, embed: bool = True,
+                    report: Callable[[str], None] | None = None) -> tuple[Matcher, Embedder | None]:
     """(matcher, embedder): the embedder only when the matcher compares appearance and ``embed``
     is set (an offline evaluation whose percepts carry cached embeddings needs none)."""
-    matcher = create_matcher(settings)
+    matcher = create_matcher(settings, report)
     needs_embedder = MATCHER_ENTRIES[settings.name].needs_embedder
-    return matcher, (create_embedder(settings) if needs_embedder and embed else None)
+    return matcher, (create_embedder(settings, report) if needs_embedder and embed else None)

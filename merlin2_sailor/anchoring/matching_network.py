@@ -39,16 +39,20 @@ another time scale outputs confident nonsense rather than an error.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from merlin2_sailor.anchoring.features import FEATURE_ENCODING_VERSION, FeatureConfig, PairFeatures
-from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+from merlin2_sailor.anchoring.features import FEATURE_ENCODING_VERSION, PairFeatures
+from merlin2_sailor.anchoring.network_inputs import (
+    NetworkMatcherConfig,
+    NetworkMetadata,
+    PairNetworkMatcher,
+    network_inputs,
+)
 from merlin2_sailor.errors import ConfigurationError, DependencyError, SailorError
-from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, COLOUR_REGIONS, colour_similarity
+from merlin2_sailor.perception.colour_histogram import COLOUR_REGIONS
 
 try:
     import torch
@@ -61,52 +65,6 @@ except ImportError as error:  # pragma: no cover - torch is a pinned requirement
 
 #: The value of the ``format`` key of every weights file this module writes.
 WEIGHTS_FORMAT = "merlin2_sailor.matching_network"
-
-
-@dataclass(frozen=True, slots=True)
-class NetworkMetadata:
-    """What a set of weights was trained with; stored in, and checked against, the weights file."""
-
-    backbone: str = "efficientnet_lite0"
-    feature_dimension: int = 1280 + COLOUR_DESCRIPTOR_SIZE  # the whole embedding, colour included
-    colour_bins: int = COLOUR_DESCRIPTOR_SIZE  # its last values, the colour descriptor (0: none)
-    feature_encoding_version: int = FEATURE_ENCODING_VERSION
-    time_scale: float = 30.0
-    siamese_units: int = 256
-    branch_units: int = 64
-    classifier_units: tuple[int, int] = (256, 64)
-    dropout: float = 0.5
-    appearance_dropout: float = 0.5
-
-    def __post_init__(self) -> None:
-        if not self.backbone:
-            raise ConfigurationError("network metadata needs a backbone name (e.g. efficientnet_lite0).")
-        for name in ("feature_dimension", "siamese_units", "branch_units"):
-            if getattr(self, name) < 1:
-                raise ConfigurationError(f"network {name} must be at least 1, got {getattr(self, name)}.")
-        if self.colour_bins not in (0, COLOUR_DESCRIPTOR_SIZE) or self.colour_bins >= self.feature_dimension:
-            raise ConfigurationError(
-                f"network colour_bins must be 0 or {COLOUR_DESCRIPTOR_SIZE} (the colour descriptor's size) and "
-                f"below feature_dimension {self.feature_dimension}, got {self.colour_bins}."
-            )
-        object.__setattr__(self, "classifier_units", tuple(int(u) for u in self.classifier_units))
-        if len(self.classifier_units) != 2 or min(self.classifier_units) < 1:
-            raise ConfigurationError(
-                f"network classifier_units must be two positive sizes, got {self.classifier_units}."
-            )
-        for name in ("dropout", "appearance_dropout"):
-            if not (0.0 <= getattr(self, name) < 1.0):
-                raise ConfigurationError(f"network {name} must be in [0, 1), got {getattr(self, name)}.")
-        FeatureConfig(time_scale=self.time_scale)  # validates the time scale
-
-    @property
-    def feature_config(self) -> FeatureConfig:
-        return FeatureConfig(time_scale=self.time_scale)
-
-    @property
-    def backbone_dimension(self) -> int:
-        """The embedding's values before its colour descriptor: the siamese branch's input."""
-        return self.feature_dimension - self.colour_bins
 
 
 def _dense(inputs: int, outputs: int) -> nn.Sequential:
@@ -169,33 +127,19 @@ class MatchingNetwork(nn.Module):
         return torch.sigmoid(self.forward(*inputs))
 
     def inputs_from(self, features: PairFeatures) -> tuple[torch.Tensor, ...]:
-        """The forward's inputs for every pair of ``features`` (appearance rows must be known): the
-        embedding difference is split into the backbone's part and the colour similarity."""
-        if features.appearance_difference is None:
-            raise SailorError("The matching network needs appearance; compute features with with_appearance=True.")
-        if features.appearance_difference.shape[1] != self.metadata.feature_dimension:
-            raise ConfigurationError(
-                f"The matching network expects {self.metadata.feature_dimension}-d {self.metadata.backbone} "
-                f"features but got {features.appearance_difference.shape[1]}-d ones; "
-                "embed crops with the same backbone."
-            )
+        """The forward's inputs for every pair of ``features``, as tensors (see :func:`.network_inputs`)."""
+        return tuple(torch.from_numpy(values) for values in network_inputs(self.metadata, features))
 
-        def column(values: np.ndarray) -> torch.Tensor:
-            return torch.from_numpy(np.ascontiguousarray(values, dtype=np.float32))
 
-        backbone = self.metadata.backbone_dimension
-        difference = features.appearance_difference
-        colour = (colour_similarity(difference[:, backbone:]) if self.metadata.colour_bins
-                  else np.ones((len(difference), COLOUR_REGIONS)))
-        return (
-            column(features.same_class),
-            column(difference[:, :backbone]),
-            column(features.distance_score),
-            column(features.scale),
-            column(features.time_score),
-            column(features.searched),
-            column(colour),
-        )
+class ProbabilityModule(nn.Module):
+    """The network with its sigmoid, in evaluation mode: what an inference runtime exports and runs."""
+
+    def __init__(self, network: MatchingNetwork) -> None:
+        super().__init__()
+        self.network = network.eval()
+
+    def forward(self, *inputs: torch.Tensor) -> torch.Tensor:
+        return self.network.probabilities(*inputs)
 
 
 def save_network(network: MatchingNetwork, path: str | Path) -> None:
@@ -258,39 +202,22 @@ def load_network(path: str | Path, backbone: str, feature_dimension: int | None 
     return network.eval()
 
 
-@dataclass(frozen=True, slots=True)
-class NetworkMatcherConfig:
-    """``fallback``: scores pairs the network cannot (an anchor or percept with no embedding, e.g.
-    a crop-less percept or an anchor restored without its gallery)."""
-
-    fallback: RuleMatcher = field(default_factory=RuleMatcher)
-
-
-class NetworkMatcher(Matcher):
-    """Runs a :class:`MatchingNetwork` on every pair in one batched forward pass."""
-
-    uses_appearance = True
+class NetworkMatcher(PairNetworkMatcher):
+    """Runs a :class:`MatchingNetwork` in torch on every pair in one batched forward pass (the
+    training path, and the ``native`` inference runtime)."""
 
     def __init__(self, network: MatchingNetwork, config: NetworkMatcherConfig | None = None) -> None:
+        super().__init__(network.metadata, config)
         self.network = network.eval()
-        self.config = config or NetworkMatcherConfig()
 
     @classmethod
     def from_file(cls, path: str | Path, backbone: str, feature_dimension: int | None = None) -> NetworkMatcher:
         return cls(load_network(path, backbone, feature_dimension))
 
     @property
-    def feature_config(self) -> FeatureConfig:
-        return self.network.metadata.feature_config
+    def threads(self) -> int:
+        return torch.get_num_threads()
 
-    def score_pairs(self, features: PairFeatures) -> np.ndarray:
-        scores = np.zeros(len(features))
-        known = features.appearance_known
-        if (~known).any():
-            scores[~known] = self.config.fallback.score_pairs(features)[~known]
-        if known.any():
-            inputs = [tensor[torch.from_numpy(known)] for tensor in self.network.inputs_from(features)]
-            with torch.inference_mode():
-                scores[known] = self.network.probabilities(*inputs).double().numpy()
-        return scores
-
+    def probabilities(self, inputs: tuple[np.ndarray, ...]) -> np.ndarray:
+        with torch.inference_mode():
+            return self.network.probabilities(*(torch.from_numpy(values) for values in inputs)).double().numpy()

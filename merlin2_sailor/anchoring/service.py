@@ -76,7 +76,7 @@ class AnchoringService:
         if saved and saved.owned_objects:
             self._symbols.note_used(saved.owned_objects)  # symbols the knowledge base has seen
         if matcher is None:
-            matcher, embedder = create_matching(self.settings.matcher)
+            matcher, embedder = create_matching(self.settings.matcher, report=lambda message: log("warning", message))
         self.matcher, self.embedder = matcher, embedder
         self.anchoring = Anchoring(self.settings.core, matcher, embedder, symbol_factory=self._new_symbol)
         if saved and saved.snapshot:
@@ -96,6 +96,14 @@ class AnchoringService:
                 sync_period=persistence.sync_period, save_period=persistence.save_period, log=log,
             )
         self._started = False
+
+    def describe_inference(self) -> str:
+        """What the network and the crop backbone run on, for the node's start-up line ("" for the rules)."""
+        if self.embedder is None and not self.matcher.uses_appearance:
+            return ""
+        threads = max(self.matcher.threads, getattr(self.embedder, "threads", 0))
+        measured = f" ({threads} threads in use)" if threads else ""
+        return f"{self.settings.matcher.inference.describe()}{measured}"
 
     def _grounding(self) -> Any:
         from merlin2_sailor.knowledge.grounding import Grounding, GroundingConfig

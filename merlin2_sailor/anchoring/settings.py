@@ -38,6 +38,7 @@ import yaml
 from merlin2_sailor.anchoring.anchoring import AnchoringConfig
 from merlin2_sailor.anchoring.matcher_registry import MATCHER_ENTRIES, MatcherSettings
 from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.inference.settings import DEVICES, PRECISIONS, RUNTIMES
 
 #: The anchoring node's default name; the node sections of a parameter file are matched against it.
 NODE_NAME = "anchoring"
@@ -182,8 +183,8 @@ SETTINGS: tuple[Setting, ...] = (
                 "Fixed frame the anchors live in (the percepts must be in it)."),
         Setting("matcher", ("matcher", "name"),
                 "Matching function: rules (class, distance, time; hand-tuned) or network (the learned "
-                "matching function of the paper, comparing crops too: embeds each new crop, ~20 ms on one "
-                "CPU core).", choices=tuple(sorted(MATCHER_ENTRIES))),
+                "matching function of the paper, comparing crops too: embeds each new crop, ~4 ms on two "
+                "CPU cores with OpenVINO).", choices=tuple(sorted(MATCHER_ENTRIES))),
         Setting("weights", ("matcher", "weights"),
                 "Weights file of the matching network (\"\" uses the weights shipped in "
                 "merlin2_sailor/models, trained by scripts/make_default_weights.sh).", deployment=True),
@@ -192,6 +193,22 @@ SETTINGS: tuple[Setting, ...] = (
         Setting("match_threshold", ("core", "match_threshold"),
                 "Score a percept-anchor pair needs to reacquire the anchor (the paper's 0.5); a percept "
                 "with no such pair acquires a new anchor.", 0.01, 1.0),
+    ),
+    *_group(
+        "Inference (the network and the crop backbone; unused by the rules)",
+        Setting("inference_runtime", ("matcher", "inference", "runtime"),
+                "openvino (models exported once from torch, then run without it: several times faster on a "
+                "CPU) or native (torch itself, the baseline).", choices=RUNTIMES),
+        Setting("inference_device", ("matcher", "inference", "device"),
+                "OpenVINO device: CPU, GPU or AUTO; a device this machine lacks falls back to the CPU with one "
+                "log line.", choices=DEVICES),
+        Setting("inference_threads", ("matcher", "inference", "threads"),
+                "Threads for inference, 0 for every core (a robot shares its cores: give this node what it "
+                "may take).", 0, 256),
+        Setting("inference_precision", ("matcher", "inference", "precision"),
+                "OpenVINO precision: f32 (as torch: the scores the weights were validated with) or auto (the "
+                "device's fastest: bfloat16 where the CPU has it, about twice as fast; match scores then move "
+                "by up to 0.05).", choices=PRECISIONS),
     ),
     *_group(
         "Rule matcher (also the network's fallback for pairs without an embedding)",

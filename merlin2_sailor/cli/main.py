@@ -24,6 +24,7 @@ SUBCOMMANDS = (
     "merlin2_sailor.cli.evaluate_command",
     "merlin2_sailor.cli.replay",
     "merlin2_sailor.cli.bench",
+    "merlin2_sailor.cli.export_models_command",
 )
 
 

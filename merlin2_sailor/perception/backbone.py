@@ -1,15 +1,18 @@
 """The port of frozen image backbones for crop embedding.
 
 A backbone turns a batch of normalised 224 px crops into one feature vector per crop. It is
-frozen: SAILOR's matching network trains on top of it, never through it. torch is imported by
-the backbone modules themselves, so this module (and a deployment without torch) stays light;
-they are chosen by name in :mod:`.backbone_registry`.
+frozen: SAILOR's matching network trains on top of it, never through it. Batches go in and out as
+NumPy arrays, so the embedder is the same whichever runtime computes the features: torch, imported
+by the torch backbone modules themselves (a deployment without torch stays light), or an exported
+model run by :mod:`.openvino_backbone`. Both are chosen in :mod:`.backbone_registry`.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 if TYPE_CHECKING:
     import torch
@@ -27,6 +30,32 @@ class Backbone(ABC):
     mean: tuple[float, float, float] = IMAGENET_MEAN
     std: tuple[float, float, float] = IMAGENET_STD
 
+    @property
+    def threads(self) -> int:
+        """Threads the features are computed with (0 when the runtime does not say)."""
+        return 0
+
     @abstractmethod
-    def features(self, batch: torch.Tensor) -> torch.Tensor:
-        """Return the pooled features of a batch, without gradients."""
+    def features(self, batch: np.ndarray) -> np.ndarray:
+        """Return the (N, feature_dimension) float32 pooled features of an (N, 3, S, S) float32 batch."""
+
+
+class TorchBackbone(Backbone):
+    """A backbone computed by a torch module (what an inference runtime's export starts from)."""
+
+    @abstractmethod
+    def feature_module(self) -> torch.nn.Module:
+        """The frozen module mapping an (N, 3, S, S) batch to its (N, feature_dimension) features."""
+
+    @property
+    def threads(self) -> int:
+        import torch
+
+        return torch.get_num_threads()
+
+    def features(self, batch: np.ndarray) -> np.ndarray:
+        import torch  # the backbone's module already imported it; this only binds the name
+
+        with torch.inference_mode():
+            tensor = torch.from_numpy(batch).contiguous(memory_format=torch.channels_last)
+            return self.feature_module()(tensor).numpy()

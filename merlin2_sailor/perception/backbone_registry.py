@@ -8,6 +8,9 @@ other. A new backbone is a module with a ``Backbone`` subclass plus one line her
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.backbone import Backbone
 from merlin2_sailor.plugins import PluginTable
 
@@ -22,6 +25,19 @@ BACKBONES = PluginTable(
 )
 
 
-def create_backbone(name: str, weights_path: str = "") -> Backbone:
-    """Build the backbone called ``name``; ``weights_path`` is needed by those without bundled weights."""
+def create_backbone(name: str, weights_path: str = "", inference: InferenceSettings | None = None,
+                    report: Callable[[str], None] | None = None) -> Backbone:
+    """Build the backbone called ``name`` for the configured inference runtime (OpenVINO by default,
+    exported once from the torch backbone; ``native`` runs torch itself); ``weights_path`` is needed
+    by those without bundled weights; ``report`` hears what a node should log (an export, a device
+    fallback)."""
+    if name not in BACKBONES:
+        BACKBONES.load(name)  # raises the table's error, which lists the known names
+    inference = inference or InferenceSettings()
+    if inference.runtime == "openvino":
+        from merlin2_sailor.perception.openvino_backbone import OpenVinoBackbone
+
+        return OpenVinoBackbone.for_backbone(
+            name, weights_path, inference, lambda: BACKBONES.create(name, weights_path), report)
+    inference.apply_to_torch()
     return BACKBONES.create(name, weights_path)

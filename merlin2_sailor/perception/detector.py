@@ -7,6 +7,7 @@ table above them, which imports only the one chosen.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -24,8 +25,14 @@ class Detector(ABC):
 
     config_class: ClassVar[type]
 
-    def __init__(self, config: Any) -> None:
+    def __init__(self, config: Any, report: Callable[[str], None] | None = None) -> None:
+        """``report`` hears what the owner should log once (a model converted, a device replaced)."""
         self.config = config
+
+    @property
+    def threads(self) -> int:
+        """Threads the backend runs its network with (0 when it does not say)."""
+        return 0
 
     @abstractmethod
     def detect(self, image_rgb: np.ndarray) -> list[Detection]:

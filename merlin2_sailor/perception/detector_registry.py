@@ -10,7 +10,7 @@ so the table and its plug-ins never import each other. A new backend is a module
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from merlin2_sailor.errors import ConfigurationError
@@ -28,8 +28,10 @@ DETECTOR_BACKENDS = PluginTable(
 )
 
 
-def create_detector(name: str, options: Mapping[str, Any] | None = None) -> Detector:
-    """Build the detector backend called ``name`` with its configuration fields ``options``.
+def create_detector(name: str, options: Mapping[str, Any] | None = None,
+                    report: Callable[[str], None] | None = None) -> Detector:
+    """Build the detector backend called ``name`` with its configuration fields ``options``;
+    ``report`` hears what the caller should log once (a model converted, a device replaced).
 
     Raises:
         ConfigurationError: an unknown backend, or an option it does not have or refuses.
@@ -43,4 +45,4 @@ def create_detector(name: str, options: Mapping[str, Any] | None = None) -> Dete
             f"Detector {name!r} has no option(s) {', '.join(sorted(unknown))}; "
             f"its options are {', '.join(sorted(config_fields))}."
         )
-    return backend(backend.config_class(**dict(options or {})))
+    return backend(backend.config_class(**dict(options or {})), report)

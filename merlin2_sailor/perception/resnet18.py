@@ -15,7 +15,7 @@ import torch
 from torch import nn
 
 from merlin2_sailor.errors import ConfigurationError, DependencyError
-from merlin2_sailor.perception.backbone import Backbone
+from merlin2_sailor.perception.backbone import TorchBackbone
 
 
 class BasicBlock(nn.Module):
@@ -66,7 +66,18 @@ class ResNet18(nn.Module):
         return self.fc(self.pooled_features(x))
 
 
-class ResNet18Backbone(Backbone):
+class PooledResNet18(nn.Module):
+    """The 512 pooled channels before the classifier, as a module of its own (what is exported)."""
+
+    def __init__(self, network: ResNet18) -> None:
+        super().__init__()
+        self.network = network
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.network.pooled_features(x)
+
+
+class ResNet18Backbone(TorchBackbone):
     """512-d features from a user-supplied torchvision ResNet-18 weights file."""
 
     feature_dimension = 512
@@ -96,8 +107,7 @@ class ResNet18Backbone(Backbone):
         # Channels-last halves the CPU time of these convolutions (oneDNN's preferred layout).
         self._network.eval().requires_grad_(False)
         self._network.to(memory_format=torch.channels_last)  # type: ignore[call-overload]
+        self._pooled = PooledResNet18(self._network).eval()
 
-    @torch.inference_mode()
-    def features(self, batch: torch.Tensor) -> torch.Tensor:
-        batch = batch.contiguous(memory_format=torch.channels_last)
-        return self._network.pooled_features(batch)
+    def feature_module(self) -> torch.nn.Module:
+        return self._pooled

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,8 +58,8 @@ class UltralyticsDetector(Detector):
 
     config_class = UltralyticsConfig
 
-    def __init__(self, config: UltralyticsConfig) -> None:
-        super().__init__(config)
+    def __init__(self, config: UltralyticsConfig, report: Callable[[str], None] | None = None) -> None:
+        super().__init__(config, report)
         weights = Path(config.weights_path).expanduser()
         if not weights.is_file():
             raise ConfigurationError(

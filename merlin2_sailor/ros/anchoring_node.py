@@ -124,9 +124,10 @@ class AnchoringNode(Node):
         self.service.start()
         self._publish_state()
         knowledge_base = settings.persistence.knowledge_base
+        inference = self.service.describe_inference()
         self.get_logger().info(
-            f"anchoring in '{self._world_frame}' with the {settings.matcher.name} matcher; "
-            f"knowledge base: {knowledge_base or 'none'}")
+            f"anchoring in '{self._world_frame}' with the {settings.matcher.name} matcher"
+            f"{f' on {inference}' if inference else ''}; knowledge base: {knowledge_base or 'none'}")
 
     def destroy_node(self) -> None:
         self._mailbox.close()

@@ -28,8 +28,10 @@ from sensor_msgs.msg import Image
 
 from merlin2_sailor.diagnostics.topic_statistics import TopicStatistics
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
+from merlin2_sailor.inference.settings import DEVICES, PRECISIONS, RUNTIMES, InferenceSettings
 from merlin2_sailor.perception.detector import Detector
 from merlin2_sailor.perception.detector_registry import DETECTOR_BACKENDS, create_detector
+from merlin2_sailor.perception.ssd_mobilenet import SsdMobileNetConfig
 from merlin2_sailor.ros.conversions import (
     detection_from_message,
     detections_to_message,
@@ -76,6 +78,21 @@ class DetectorNode(Node):
         report_period = declare_parameter(
             self, "report_period", 10.0, "Seconds between two statistics log lines.", minimum=0.5, maximum=3600.0,
         )
+        defaults = SsdMobileNetConfig().inference
+        inference = InferenceSettings(
+            runtime=declare_parameter(
+                self, "inference_runtime", defaults.runtime,
+                f"ssd_mobilenet's runtime: {' or '.join(RUNTIMES)} (OpenCV DNN)."),
+            device=declare_parameter(
+                self, "inference_device", defaults.device,
+                f"OpenVINO device: {', '.join(DEVICES)}; one this machine lacks falls back to the CPU."),
+            threads=declare_parameter(
+                self, "inference_threads", defaults.threads, "Inference threads, 0 for every core.",
+                minimum=0, maximum=256),
+            precision=declare_parameter(
+                self, "inference_precision", defaults.precision,
+                f"OpenVINO precision: {' or '.join(PRECISIONS)} (the device's fastest: bfloat16 where it has it)."),
+        )
 
         self._publisher = self.create_publisher(DetectionArray, DETECTIONS_TOPIC, SENSOR_DATA)
         self._report_period = report_period
@@ -91,16 +108,19 @@ class DetectorNode(Node):
             self.create_subscription(DetectionArray, EXTERNAL_DETECTIONS_TOPIC, self._republish, SENSOR_DATA)
             source = f"republishing '{self.resolve_topic_name(EXTERNAL_DETECTIONS_TOPIC)}'"
         else:
-            self._detector = self._build_detector(backend, score_threshold, classes, weights, device)
+            self._detector = self._build_detector(backend, score_threshold, classes, weights, device, inference)
             self.create_subscription(Image, IMAGE_TOPIC, self._mailbox.put, SENSOR_DATA)
             self._worker = threading.Thread(target=self._detect_frames, name="detector", daemon=True)
             self._worker.start()
-            source = f"{backend} on '{self.resolve_topic_name(IMAGE_TOPIC)}'"
+            runtime = (f" ({inference.describe()}: {self._detector.threads} threads)"
+                       if backend == "ssd_mobilenet" else "")
+            source = f"{backend}{runtime} on '{self.resolve_topic_name(IMAGE_TOPIC)}'"
         self.create_timer(report_period, self._report)
         self.get_logger().info(f"{source} -> '{self.resolve_topic_name(DETECTIONS_TOPIC)}'")
 
     def _build_detector(
-        self, backend: str, score_threshold: float, classes: list[str], weights: str, device: str
+        self, backend: str, score_threshold: float, classes: list[str], weights: str, device: str,
+        inference: InferenceSettings,
     ) -> Detector:
         if backend not in DETECTOR_BACKENDS:
             raise ConfigurationError(f"backend must be one of {', '.join(BACKENDS)}, got '{backend}'")
@@ -114,8 +134,8 @@ class DetectorNode(Node):
                 raise ConfigurationError("the 'classes' filter is supported by the ssd_mobilenet backend only")
             options: dict[str, Any] = {"weights_path": weights, "score_threshold": score_threshold, "device": device}
         else:
-            options = {"score_threshold": score_threshold, "classes": tuple(classes)}
-        return create_detector(backend, options)
+            options = {"score_threshold": score_threshold, "classes": tuple(classes), "inference": inference}
+        return create_detector(backend, options, self.get_logger().warning)
 
     def _detect_frames(self) -> None:
         """Worker thread: detect on the newest waiting frame, publish, repeat until closed."""

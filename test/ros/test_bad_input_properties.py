@@ -349,11 +349,17 @@ def test_anchoring_survives_garbage_keeps_its_anchors_and_keeps_pddl_clean(tmp_p
         assert after[symbol].class_name == class_name
         np.testing.assert_allclose([position.x, position.y, position.z], place, atol=0.2)
     hostile_objects: list[str] = []
+    shown_again = [time.monotonic()]
 
     def hostile_objects_arrived() -> bool:
         with open_store(f"ros://{namespace}") as store:
             hostile_objects[:] = [item.name for item in store.objects.get_all()
                                   if item.name.startswith(("id_goal", "cafe"))]
+        if not hostile_objects and time.monotonic() - shown_again[0] > 2.0:
+            # A busy node keeps only the newest of frames sent back to back, so the three sightings
+            # that confirm an anchor may have reached it as one: show the frames again, as a camera would.
+            publish_batch(publishers, hostile_class_frames())
+            shown_again[0] = time.monotonic()
         return bool(hostile_objects)
 
     ros_probe.wait_for(lambda: len(events) >= 3, timeout=10.0)

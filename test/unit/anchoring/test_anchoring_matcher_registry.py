@@ -17,6 +17,7 @@ from merlin2_sailor.anchoring.matcher_registry import (
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.anchoring.settings import SETTINGS_BY_NAME
 from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.inference.settings import InferenceSettings
 
 
 def test_each_entry_says_what_its_class_says_about_appearance() -> None:
@@ -40,20 +41,23 @@ def test_choosing_the_rules_never_imports_torch() -> None:
     assert printed.stdout.strip() == "False"
 
 
-def test_the_network_loads_the_weights_and_falls_back_on_the_configured_rules(tmp_path) -> None:
+@pytest.mark.parametrize("runtime", ["openvino", "native"])
+def test_the_network_loads_the_weights_and_falls_back_on_the_configured_rules(tmp_path, runtime) -> None:
     torch = pytest.importorskip("torch")
     from merlin2_sailor.anchoring.matching_network import NetworkMatcher
+    from merlin2_sailor.anchoring.openvino_matcher import OpenVinoNetworkMatcher
 
     rules = RuleMatcherConfig(maximum_sigma=0.3)
-    matcher = create_matcher(MatcherSettings(name="network", rules=rules))
-    assert isinstance(matcher, NetworkMatcher)
+    inference = InferenceSettings(runtime=runtime, threads=1)
+    matcher = create_matcher(MatcherSettings(name="network", rules=rules, inference=inference))
+    assert isinstance(matcher, {"openvino": OpenVinoNetworkMatcher, "native": NetworkMatcher}[runtime])
     assert matcher.config.fallback.config == rules
     # Only an evaluation whose percepts carry cached embeddings asks for no embedder.
-    assert create_matching(MatcherSettings(name="network"), embed=False)[1] is None
+    assert create_matching(MatcherSettings(name="network", inference=inference), embed=False)[1] is None
     # The weights setting is the file read.
     torch.save({"state_dict": {}}, tmp_path / "weights.pt")
     with pytest.raises(ConfigurationError, match="weights.pt is not a merlin2_sailor matching network file"):
-        create_matcher(MatcherSettings(name="network", weights=str(tmp_path / "weights.pt")))
+        create_matcher(MatcherSettings(name="network", weights=str(tmp_path / "weights.pt"), inference=inference))
 
 
 def test_an_unknown_matcher_lists_the_known_ones() -> None:

@@ -1,0 +1,136 @@
+"""The whole pipeline with the real detector and the learned matcher, old inference path against new.
+
+The graph of ``bench_pipeline.py`` with the detector node put back between the camera and the
+percept generator: the player's 10 objects show real photos (Debian darknet's dogs, horses,
+people, ...), the SSD-MobileNet detector finds them, ByteTrack tracks them, and the anchoring node
+scores every new crop with the learned matching function (``matcher: network``, crops embedded by
+EfficientNet-Lite0). It runs twice, each run with the shipped configuration otherwise:
+
+- old path: ``inference_runtime: native`` (OpenCV DNN for the detector, torch for the backbone and
+  the network);
+- new path: ``inference_runtime: openvino`` (the exported models; each node's default precision:
+  the device's fastest for the detector, float32 for the matching path).
+
+Per path and phase (15 Hz, then 30 Hz): latency image stamp -> AnchorArray (p50, p95, max), frames
+the detector dropped (newest wins: what it cannot keep up with), frames dropped after it (what the
+target forbids), and each node's CPU and resident memory. Targets (issue 16), for the new path at
+15 Hz: no frame dropped after the detector and p95 < 100 ms. Nothing is asserted.
+
+Run: python bench/bench_pipeline_detector.py [--quick] [--duration S] [--node-log PATH] [--json PATH]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+from harness import script
+from harness.pipeline_analysis import analyse, match
+from harness.pipeline_run import PipelineConfig, Recording, isolate_ros_domain, phases_of, run_pipeline
+from harness.results import BenchmarkResult, Table
+
+OBJECTS = 10
+TARGET_PHASE = "15 Hz"
+LATENCY_TARGET_MS = 100.0
+PATHS = {"openvino": "new path (OpenVINO)", "native": "old path (OpenCV DNN + torch)"}
+
+
+def detector_dropped(recording: Recording, phase_index: int) -> tuple[int, int]:
+    """(measured frames of the phase, those the detector published no DetectionArray for)."""
+    frames = np.array(recording.played["frames"], dtype=np.int64).reshape(-1, 3)
+    stamps = np.sort(frames[:, 0])
+    measured = frames[(frames[:, 1] == phase_index) & (frames[:, 2] == 1), 0]
+    seen = np.zeros(len(stamps), dtype=bool)
+    indices = match(stamps, sorted(recording.detections))
+    seen[indices[indices >= 0]] = True
+    positions = np.searchsorted(stamps, measured)
+    return len(measured), int((~seen[positions]).sum())
+
+
+def run_path(runtime: str, phases, quick: bool, node_log: Path | None) -> tuple[Recording, list]:
+    config = PipelineConfig(objects=OBJECTS, phases=phases, sample_period=0.5 if quick else 1.0, drain_seconds=2.0,
+                            detector=True,
+                            anchoring_parameters=(("matcher", "network"), ("inference_runtime", runtime)),
+                            detector_parameters=(("inference_runtime", runtime),))
+    print(f"  {PATHS[runtime]}: playing {' then '.join(p.label + f' for {p.seconds:g} s' for p in phases)}", flush=True)
+    recording = run_pipeline(config, echo=lambda line: print(f"  [{runtime}] {line}", flush=True))
+    if node_log is not None:
+        node_log.parent.mkdir(parents=True, exist_ok=True)
+        with node_log.open("a") as stream:
+            stream.write(f"=== {PATHS[runtime]} ===\n" + "\n".join(recording.log) + "\n")
+    return recording, analyse(recording.played, recording.percepts, recording.anchors, recording.events,
+                              recording.samples)
+
+
+def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None) -> BenchmarkResult:
+    seconds = duration or (12.0 if quick else 60.0)
+    phases = phases_of([(TARGET_PHASE, 15.0, seconds, min(4.0, seconds / 3)),
+                        ("30 Hz", 30.0, seconds / 2, min(3.0, seconds / 6))])
+    result = BenchmarkResult(
+        "pipeline_detector", f"Whole pipeline with the real detector and the learned matcher, {OBJECTS} objects",
+        "frame_player (10 photo objects at 640x480) -> detector (SSD-MobileNet) -> percept_generator (ByteTrack) -> "
+        "anchoring (matcher: network) -> knowledge_base, each its own process; once per inference path: "
+        + "; ".join(PATHS.values()) + ". Phases: "
+        + ", ".join(f"{p.label} for {p.seconds:g} s (first {p.settle_seconds:g} s not measured)" for p in phases),
+        parameters={"objects": OBJECTS, "phases": [p.__dict__ for p in phases]},
+    )
+    runs = {runtime: run_path(runtime, phases, quick, node_log) for runtime in PATHS}
+    rows, nodes = [], []
+    for index, phase in enumerate(phases):
+        figures = {}
+        for runtime, (recording, statistics) in runs.items():
+            stats = next((s for s in statistics if s.label == phase.label), None)
+            if stats is None:
+                continue
+            frames, at_detector = detector_dropped(recording, index)
+            after_detector = stats.dropped - at_detector
+            figures[runtime] = (stats, at_detector, after_detector)
+            rows.append([phase.label, PATHS[runtime], frames, round(stats.output_rate_hz, 1), at_detector,
+                         after_detector, round(stats.latency(0.5), 1), round(stats.latency(0.95), 1),
+                         round(max(stats.latencies_ms, default=math.nan), 1), stats.anchors_at_end])
+            for label, trend in sorted(stats.memory.items()):
+                if label in recording.config.node_labels:
+                    nodes.append([phase.label, PATHS[runtime], label, round(trend.cpu_percent, 1),
+                                  round(trend.peak_mb, 1)])
+        if len(figures) < 2:
+            continue
+        (new, new_at, new_after), (old, old_at, old_after) = figures["openvino"], figures["native"]
+        targets = phase.label == TARGET_PHASE
+        p95 = new.latency(0.95)
+        result.figure(f"{phase.label}: latency p50", new.latency(0.5), "ms", baseline=old.latency(0.5),
+                      baseline_name=PATHS["native"])
+        result.figure(f"{phase.label}: latency p95", p95, "ms", baseline=old.latency(0.95),
+                      baseline_name=PATHS["native"],
+                      **({"target": f"< {LATENCY_TARGET_MS:.0f} ms", "met": p95 < LATENCY_TARGET_MS}
+                         if targets else {}))
+        result.figure(f"{phase.label}: AnchorArray rate", new.output_rate_hz, "Hz", baseline=old.output_rate_hz,
+                      baseline_name=PATHS["native"], better="higher")
+        result.figure(f"{phase.label}: frames dropped by the detector (newest wins)", new_at,
+                      f"of {new.frames} frames", baseline=old_at, baseline_name=PATHS["native"])
+        result.figure(f"{phase.label}: frames dropped after the detector", new_after, f"of {new.frames} frames",
+                      baseline=old_after, baseline_name=PATHS["native"],
+                      **({"target": "none", "met": new_after == 0} if targets else {}))
+    result.tables.append(Table(
+        "per path and phase (measured frames; latency = image stamp -> AnchorArray published)",
+        ["phase", "path", "frames", "AnchorArray Hz", "dropped at detector", "dropped after detector", "p50 ms",
+         "p95 ms", "max ms", "anchors"], rows))
+    result.tables.append(Table("per node (CPU: % of one core; peak resident memory)",
+                               ["phase", "path", "node", "CPU %", "peak RSS MB"], nodes))
+    return result
+
+
+def extend(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--duration", type=float, default=0.0, metavar="S",
+                        help="seconds of the 15 Hz phase (default 60, quick 12); the 30 Hz phase is half of it")
+    parser.add_argument("--node-log", type=Path, default=None, metavar="PATH", help="write the nodes' output here")
+
+
+def main() -> int:
+    isolate_ros_domain()
+    return script.main(run, __doc__, extend=extend)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,104 @@
+"""Compiling an exported model for a device, with the thread count and precision this project needs.
+
+Two choices are made here once for every network: the precision (``auto`` lets OpenVINO take the
+device's fastest, bfloat16 on CPUs with AVX-512 BF16 or AMX, about twice float32's speed; ``f32``
+keeps float32 throughout, for exact parity with torch), and a latency hint (one frame at a time,
+as a camera delivers them, rather than throughput over many parallel requests). A device the machine lacks
+(``GPU`` on a laptop without one) is reported in one line and replaced by the CPU.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from merlin2_sailor.errors import DependencyError
+from merlin2_sailor.inference.model_cache import cache_folder
+from merlin2_sailor.inference.settings import InferenceSettings
+
+OPENVINO_HINT = "Install the OpenVINO runtime (`pip install openvino==2026.4.1`; scripts/setup.sh does)."
+
+_logger = logging.getLogger(__name__)
+_core_lock = threading.Lock()
+_core = None
+
+
+def openvino_core():  # -> openvino.Core (typed loosely: openvino is imported lazily)
+    """The process's one OpenVINO Core (it caches device plug-ins, so one is enough)."""
+    global _core
+    with _core_lock:
+        if _core is None:
+            try:
+                import openvino
+            except ImportError as error:
+                raise DependencyError(f"The openvino inference runtime is not installed. {OPENVINO_HINT}") from error
+            _core = openvino.Core()
+            # Compiled blobs are cached beside the exported models: a node's second start, or a
+            # second detector in one process, skips the compilation (seconds on two cores).
+            _core.set_property({"CACHE_DIR": str(cache_folder() / "compiled")})
+        return _core
+
+
+def choose_device(requested: str, available: Sequence[str], report: Callable[[str], None]) -> str:
+    """``requested`` if the machine has it (``GPU`` matches ``GPU.0``), else the CPU, said once."""
+    if requested in ("CPU", "AUTO") or any(device.split(".")[0] == requested for device in available):
+        return requested
+    report(f"inference device {requested} is not available on this machine (it has {', '.join(available) or 'none'}); "
+           "running on the CPU")
+    return "CPU"
+
+
+class CompiledNetwork:
+    """A model compiled for one device: call it with NumPy arrays, get its outputs as arrays.
+
+    One inference request, guarded by a lock: nodes call from one worker thread, and the lock makes
+    a second caller wait rather than corrupt the request's buffers.
+    """
+
+    def __init__(self, model_path: Path, settings: InferenceSettings,
+                 report: Callable[[str], None] | None = None) -> None:
+        core = openvino_core()
+        report = report or _logger.warning
+        self.device = choose_device(settings.device, core.available_devices, report)
+        config: dict[str, object] = {"PERFORMANCE_HINT": "LATENCY"}
+        if settings.precision == "f32":
+            config["INFERENCE_PRECISION_HINT"] = "f32"
+        if settings.threads and self.device == "CPU":
+            config["INFERENCE_NUM_THREADS"] = settings.threads
+        self._compiled = core.compile_model(str(model_path), self.device, config)
+        self._request = self._compiled.create_infer_request()
+        self._lock = threading.Lock()
+        self.input_names = tuple(port.get_any_name() for port in self._compiled.inputs)
+        self._output_names = tuple(frozenset(port.get_names()) for port in self._compiled.outputs)
+
+    def output_index(self, name: str) -> int:
+        """Where the output called ``name`` is in what a call returns."""
+        for index, names in enumerate(self._output_names):
+            if name in names:
+                return index
+        raise KeyError(f"the model has no output {name!r}")
+
+    @property
+    def precision(self) -> str:
+        """The precision the runtime computes in (``bf16``, ``f32``, ...)."""
+        try:
+            return str(self._compiled.get_property("INFERENCE_PRECISION_HINT")).rsplit(".", 1)[-1].lower()
+        except Exception:  # a device without the property
+            return "?"
+
+    @property
+    def threads(self) -> int:
+        """Threads the runtime runs this model with (what a node reports)."""
+        try:
+            return int(self._compiled.get_property("INFERENCE_NUM_THREADS"))
+        except Exception:  # a device without the property (GPU) runs on its own threads
+            return 0
+
+    def __call__(self, *inputs: np.ndarray) -> list[np.ndarray]:
+        with self._lock:
+            results = self._request.infer([np.ascontiguousarray(array) for array in inputs])
+            return [np.array(results[port]) for port in self._compiled.outputs]
