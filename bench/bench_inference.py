@@ -8,7 +8,10 @@ Three networks, each figure beside its baseline measured in the same run on the 
   against OpenCV DNN, both fed the same 300 px resize;
 - the matching network's heads, ms per call for a frame's pairs: OpenVINO against torch;
 
-each with 2 threads (the target machine: two cores) and 1 thread, and the resident memory of the
+each with 2 threads (the target machine: two cores) and 1 thread, OpenVINO in float32 (``f32``, as
+torch; the matching path's default) and in the device's fastest precision (``auto``: bfloat16 on
+CPUs with AVX-512 BF16 or AMX; the detector's default; torch and OpenCV DNN stay float32), and the
+resident memory of the
 anchoring service with the learned matcher (its matcher and crop embedder built, a frame
 embedded and scored), each runtime in a fresh process, and whether that process imported torch.
 Targets (issue 16): embedding <= 5 ms/crop and >= 2.5x torch; detector <= 25 ms/frame and >= 2x
@@ -37,7 +40,7 @@ from harness.results import BenchmarkResult, Table, median_seconds
 
 from merlin2_sailor.anchoring.features import PairFeatures
 from merlin2_sailor.anchoring.matcher_registry import MatcherSettings, create_matcher
-from merlin2_sailor.inference.settings import InferenceSettings
+from merlin2_sailor.inference.settings import PRECISIONS, InferenceSettings
 from merlin2_sailor.perception.detector_registry import create_detector
 from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
 
@@ -86,8 +89,8 @@ def frame_pairs(count: int, dimension: int) -> PairFeatures:
         appearance_difference=difference)
 
 
-def settings(runtime: str, threads: int) -> InferenceSettings:
-    return InferenceSettings(runtime=runtime, threads=threads)
+def settings(runtime: str, threads: int, precision: str) -> InferenceSettings:
+    return InferenceSettings(runtime=runtime, threads=threads, precision=precision)
 
 
 def compare(result: BenchmarkResult, rows: list[list[object]], label: str, unit: str,
@@ -107,7 +110,7 @@ MEMORY_PROBE = textwrap.dedent("""
     import numpy as np
     from merlin2_sailor.anchoring.service import AnchoringService
     from merlin2_sailor.anchoring.settings import default_settings
-    from merlin2_sailor.inference.settings import InferenceSettings
+    from merlin2_sailor.inference.settings import PRECISIONS, InferenceSettings
     import dataclasses
     base = default_settings()
     matcher = dataclasses.replace(base.matcher, name="network", inference=InferenceSettings(runtime=sys.argv[1]))
@@ -128,28 +131,29 @@ def service_memory(runtime: str) -> dict[str, float]:
 
 def measure_threads(result: BenchmarkResult, rows: list[list[object]], threads: int, photos: list[np.ndarray],
                     crops: list[np.ndarray], batch_sizes: tuple[int, ...], repeats: int) -> None:
-    """Every network on both runtimes with ``threads`` threads; targets apply to two threads (two cores)."""
-    on_two_cores = threads == 2
-    embedders = {runtime: {size: CropEmbedder(EmbeddingConfig(batch_size=size, inference=settings(runtime, threads)))
-                           for size in batch_sizes} for runtime in RUNTIMES}
-    for size in batch_sizes:
-        compare(result, rows, f"embedding, batch {size}, {threads} thread(s)", "ms/crop",
-                lambda runtime, s=size: median_seconds(lambda: embedders[runtime][s].embed(crops), repeats)
-                / len(crops) * 1e3,
-                target="<= 5 ms/crop, >= 2.5x torch" if on_two_cores else "",
-                target_value=5.0 if on_two_cores else None)
-    detectors = {runtime: create_detector("ssd_mobilenet", {"inference": settings(runtime, threads)})
-                 for runtime in RUNTIMES}
-    compare(result, rows, f"detector, {threads} thread(s)", "ms/frame",
-            lambda runtime: median_seconds(lambda: [detectors[runtime].detect(p) for p in photos], repeats)
-            / len(photos) * 1e3,
-            target="<= 25 ms/frame, >= 2x OpenCV DNN" if on_two_cores else "",
-            target_value=25.0 if on_two_cores else None)
-    matchers = {runtime: create_matcher(MatcherSettings(name="network", inference=settings(runtime, threads)))
+    """Every network on both runtimes with ``threads`` threads, in float32 and (OpenVINO) in the
+    device's fastest precision; targets apply to two threads (two cores)."""
+    two_cores = threads == 2
+    embedding_target = {"target": "<= 5 ms/crop, >= 2.5x torch", "target_value": 5.0} if two_cores else {}
+    for precision in PRECISIONS:
+        embedders = {runtime: {size: CropEmbedder(EmbeddingConfig(
+            batch_size=size, inference=settings(runtime, threads, precision))) for size in batch_sizes}
+            for runtime in RUNTIMES}
+        for size in batch_sizes if precision == "f32" else (EmbeddingConfig().batch_size,):
+            compare(result, rows, f"embedding, batch {size}, {threads} thread(s), {precision}", "ms/crop",
+                    lambda runtime, s=size, e=embedders: median_seconds(lambda: e[runtime][s].embed(crops), repeats)
+                    / len(crops) * 1e3, **embedding_target)
+        detectors = {runtime: create_detector("ssd_mobilenet", {"inference": settings(runtime, threads, precision)})
+                     for runtime in RUNTIMES}
+        compare(result, rows, f"detector, {threads} thread(s), {precision}", "ms/frame",
+                lambda runtime, d=detectors: median_seconds(lambda: [d[runtime].detect(p) for p in photos], repeats)
+                / len(photos) * 1e3,
+                **({"target": "<= 25 ms/frame, >= 2x OpenCV DNN", "target_value": 25.0} if two_cores else {}))
+    matchers = {runtime: create_matcher(MatcherSettings(name="network", inference=settings(runtime, threads, "f32")))
                 for runtime in RUNTIMES}
     for pairs in (20, 200):
         features = frame_pairs(pairs, matchers["native"].metadata.feature_dimension)
-        compare(result, rows, f"matching network, {pairs} pairs, {threads} thread(s)", "ms/call",
+        compare(result, rows, f"matching network, {pairs} pairs, {threads} thread(s), f32", "ms/call",
                 lambda runtime, f=features: median_seconds(lambda: matchers[runtime].score_pairs(f), repeats * 3)
                 * 1e3)
 

@@ -42,7 +42,7 @@ from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 
-from harness.scene import Scene, detections_of, load_photos, make_scene
+from harness.scene import Scene, detections_of, load_object_photos, make_scene
 from merlin2_sailor.ros.conversions import array_to_image, camera_info_message, detections_to_message, pose_to_message
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_interfaces.msg import DetectionArray
@@ -167,7 +167,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rclpy.init(args=arguments, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("frame_player")
     try:
-        scene = make_scene(options.objects, options.seed, photos=load_photos() if options.detector else ())
+        photos = load_object_photos(options.objects) if options.detector else []
+        scene = make_scene(options.objects, options.seed, photos=photos)
         player = FramePlayer(node, scene, with_detector=options.detector)
         deadline = time.monotonic() + GRAPH_TIMEOUT_SECONDS
         while not player.graph_ready(options.percepts_subscribers):

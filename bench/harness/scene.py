@@ -28,6 +28,8 @@ WIDTH, HEIGHT = 640, 480
 WALL_MILLIMETRES = 5000
 MISSING_DEPTH_FRACTION = 0.02
 BOX_NOISE_PIXELS = 1.0
+#: The most of its cell a photo object fills (SSD-MobileNet misses most objects under ~80 px).
+PHOTO_CELL_FRACTION = 0.9
 #: Everyday classes, most of them grounded to their own PDDL type by config/grounding.yaml.
 CLASS_NAMES = ("cup", "book", "bottle", "bowl", "teddy bear", "cell phone", "wine glass", "chair", "laptop", "vase")
 #: Camera 1 m above the map origin looking along world +x (optical z forward, x right, y down).
@@ -68,6 +70,11 @@ def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int
         centre_x = (column + 0.5 + rng.uniform(-0.1, 0.1)) * cell_width
         centre_y = (row + 0.5 + rng.uniform(-0.1, 0.1)) * cell_height
         box = BoundingBox2D(centre_x, centre_y, 0.6 * cell_width, 0.6 * cell_height)
+        if photos:  # as large as the cell allows with the photo's own aspect: the detector needs size
+            photo_height, photo_width = photos[index % len(photos)].shape[:2]
+            scale = PHOTO_CELL_FRACTION * min(cell_width / photo_width, cell_height / photo_height)
+            box = BoundingBox2D((column + 0.5) * cell_width, (row + 0.5) * cell_height,
+                                photo_width * scale, photo_height * scale)
         x_min, y_min, x_max, y_max = (int(round(v)) for v in box.corners)
         distance = rng.uniform(1500.0, 3500.0)
         depth[y_min:y_max, x_min:x_max] = (distance + rng.normal(0.0, 5.0, (y_max - y_min, x_max - x_min))).astype(
@@ -94,13 +101,32 @@ def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int
 PHOTO_NAMES = ("dog", "horses", "person", "giraffe", "eagle", "kite")
 
 
-def load_photos() -> list[np.ndarray]:
-    """The darknet photos (RGB) from ``SAILOR_DARKNET_DATA``; none where they are missing."""
+def load_object_photos(count: int) -> list[np.ndarray]:
+    """Up to ``count`` photos of single objects (RGB): the objects the SSD detector finds with a score
+    of 0.7 or more in the darknet photos of ``SAILOR_DARKNET_DATA``, each cut out with a margin, so
+    that each of the scene's objects is one the detector can find again (a whole photo shrunk into
+    a scene's cell holds objects too small for it). None where the photos are missing."""
     import cv2
+
+    from merlin2_sailor.perception.detector_registry import create_detector
 
     folder = Path(os.environ.get("SAILOR_DARKNET_DATA") or "/usr/share/darknet/data")
     images = [cv2.imread(str(folder / f"{name}.jpg")) for name in PHOTO_NAMES]
-    return [cv2.cvtColor(image, cv2.COLOR_BGR2RGB) for image in images if image is not None]
+    photos = [cv2.cvtColor(image, cv2.COLOR_BGR2RGB) for image in images if image is not None]
+    if not photos:
+        return []
+    detector = create_detector("ssd_mobilenet", {"score_threshold": 0.7})
+    objects = []
+    for photo in photos:
+        height, width = photo.shape[:2]
+        for detection in detector.detect(photo):
+            x_min, y_min, x_max, y_max = detection.box.corners
+            margin_x, margin_y = 0.1 * (x_max - x_min), 0.1 * (y_max - y_min)
+            x0, y0 = int(max(x_min - margin_x, 0)), int(max(y_min - margin_y, 0))
+            x1, y1 = int(min(x_max + margin_x, width)), int(min(y_max + margin_y, height))
+            if x1 - x0 >= 40 and y1 - y0 >= 40:
+                objects.append(photo[y0:y1, x0:x1].copy())
+    return objects[:count]
 
 
 def detections_of(scene: Scene, rng: np.random.Generator, noise: float = BOX_NOISE_PIXELS) -> list[Detection]:
