@@ -10,8 +10,8 @@ to the rules). A parity test holds the two within 1e-5 on the same pairs.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -24,59 +24,38 @@ from merlin2_sailor.anchoring.network_inputs import (
     PairNetworkMatcher,
 )
 from merlin2_sailor.errors import ConfigurationError, DependencyError
-from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, find_exported, fingerprint, store_exported
+from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, ensure_exported, fingerprint
 from merlin2_sailor.inference.openvino_runtime import CompiledNetwork
 from merlin2_sailor.inference.settings import InferenceSettings
 
 MODEL_NAME = "matching-network"
 
 
-def export_matching_network(weights: Path, backbone: str, folder: Path | None = None) -> ExportedModel:
-    """Convert the network in ``weights`` (checked against ``backbone``) to an OpenVINO model in the cache."""
-    from dataclasses import asdict
-
-    import torch
-
-    from merlin2_sailor.anchoring.matching_network import ProbabilityModule, load_network
-    from merlin2_sailor.inference.torch_export import save_torch_module
-
-    network = load_network(weights, backbone)
-    metadata = network.metadata
-    example = (torch.zeros(2), torch.zeros(2, metadata.backbone_dimension), torch.zeros(2), torch.zeros(2),
-               torch.zeros(2), torch.zeros(2), torch.zeros(2, 2))
-    shapes = [(-1,), (-1, metadata.backbone_dimension), (-1,), (-1,), (-1,), (-1,), (-1, 2)]
+def ensure_matching_network(weights: Path, backbone: str, folder: Path | None = None,
+                            report: Callable[[str], None] | None = None) -> ExportedModel:
+    """The exported network of ``weights`` (checked against ``backbone``), converted first when missing."""
+    weights = Path(weights)
+    if not weights.is_file():
+        raise DependencyError(f"Matching network weights file {weights} not found.")
 
     def write(target: Path) -> dict[str, object]:
+        import torch
+
+        from merlin2_sailor.anchoring.matching_network import ProbabilityModule, load_network
+        from merlin2_sailor.inference.torch_export import save_torch_module
+
+        network = load_network(weights, backbone)
+        metadata = network.metadata
+        example = (torch.zeros(2), torch.zeros(2, metadata.backbone_dimension), torch.zeros(2), torch.zeros(2),
+                   torch.zeros(2), torch.zeros(2), torch.zeros(2, 2))
+        shapes = [(-1,), (-1, metadata.backbone_dimension), (-1,), (-1,), (-1,), (-1,), (-1, 2)]
         save_torch_module(ProbabilityModule(network), example, shapes, target / MODEL_FILE, INPUT_NAMES)
         recorded = asdict(metadata)
         recorded["classifier_units"] = list(recorded["classifier_units"])
         return {"network": recorded, "weights": str(weights)}
 
-    return store_exported(MODEL_NAME, fingerprint(backbone, Path(weights)), write, folder)
-
-
-def ensure_matching_network(weights: Path, backbone: str, folder: Path | None = None,
-                            report: Callable[[str], None] | None = None) -> ExportedModel:
-    """The exported network of ``weights``, exporting it first (said through ``report``) when missing."""
-    weights = Path(weights)
-    if not weights.is_file():
-        raise DependencyError(f"Matching network weights file {weights} not found.")
-    exported = find_exported(MODEL_NAME, fingerprint(backbone, weights), folder)
-    if exported is not None:
-        return exported
-    try:
-        import torch  # noqa: F401  (only to tell a missing export from a missing torch)
-    except ImportError as error:
-        raise DependencyError(
-            f"No exported matching network for {weights} in the model cache, and torch (needed to export it) is "
-            "not installed. Run `sailor export-models` on a machine with torch and point SAILOR_MODEL_CACHE at it."
-        ) from error
-    started = time.monotonic()
-    exported = export_matching_network(weights, backbone, folder)
-    if report is not None:
-        report(f"exported the matching network {weights.name} for OpenVINO in {time.monotonic() - started:.1f} s "
-               f"(once; cached in {exported.folder})")
-    return exported
+    return ensure_exported(MODEL_NAME, fingerprint(backbone, weights), write, f"matching network {weights.name}",
+                           needs_torch=True, folder=folder, report=report)
 
 
 class OpenVinoNetworkMatcher(PairNetworkMatcher):

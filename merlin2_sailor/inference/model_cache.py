@@ -19,11 +19,14 @@ import json
 import os
 import shutil
 import tempfile
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
+
+from merlin2_sailor.errors import DependencyError
 
 #: Bump when the export code changes what it writes: every cached model is then exported anew.
 EXPORT_FORMAT = 1
@@ -107,4 +110,29 @@ def store_exported(
         shutil.rmtree(staging, ignore_errors=True)
     exported = find_exported(name, model_fingerprint, root)
     assert exported is not None
+    return exported
+
+
+def ensure_exported(name: str, model_fingerprint: str, write: Callable[[Path], Mapping[str, Any]], what: str,
+                    needs_torch: bool, folder: Path | None = None,
+                    report: Callable[[str], None] | None = None) -> ExportedModel:
+    """The exported model, exporting it first when missing (said in one line through ``report``);
+    ``what`` names it in messages; ``needs_torch``: the export needs torch, so without torch a
+    missing export is an error saying how to get one, not an ImportError from deep inside."""
+    exported = find_exported(name, model_fingerprint, folder)
+    if exported is not None:
+        return exported
+    if needs_torch:
+        try:
+            import torch  # noqa: F401  (only to tell a missing export from a missing torch)
+        except ImportError as error:
+            raise DependencyError(
+                f"No exported {what} in the model cache ({folder or cache_folder()}), and torch (needed to export "
+                f"it) is not installed. Run `sailor export-models` on a machine with torch and point "
+                f"{CACHE_VARIABLE} at its output.") from error
+    started = time.monotonic()
+    exported = store_exported(name, model_fingerprint, write, folder)
+    if report is not None:
+        report(f"exported {what} for OpenVINO in {time.monotonic() - started:.1f} s "
+               f"(once; cached in {exported.folder})")
     return exported

@@ -12,14 +12,13 @@ exports it only when it is missing and torch is importable.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from merlin2_sailor.errors import DependencyError
-from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, find_exported, fingerprint, store_exported
+from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, ensure_exported, fingerprint
 from merlin2_sailor.inference.openvino_runtime import CompiledNetwork
 from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.backbone import Backbone, TorchBackbone
@@ -38,47 +37,27 @@ def backbone_fingerprint(name: str, weights_path: str = "") -> str:
 TorchBackboneFactory = Callable[[], Backbone]
 
 
-def export_backbone(name: str, build_torch: TorchBackboneFactory, weights_path: str = "",
-                    folder: Path | None = None) -> ExportedModel:
-    """Convert backbone ``name`` (``build_torch()``: the torch backbone with its weights) to an
-    OpenVINO model in the cache."""
-    import torch
-
-    from merlin2_sailor.inference.torch_export import save_torch_module
-
-    backbone = build_torch()
-    if not isinstance(backbone, TorchBackbone):
-        raise DependencyError(f"The {name} backbone is not a torch module and cannot be exported.")
-    size = backbone.input_size
+def ensure_backbone(name: str, build_torch: TorchBackboneFactory, weights_path: str = "",
+                    folder: Path | None = None, report: Callable[[str], None] | None = None) -> ExportedModel:
+    """The exported backbone ``name``, converted first (``build_torch()``: the torch backbone with its
+    weights) when the cache lacks it."""
 
     def write(target: Path) -> dict[str, object]:
+        import torch
+
+        from merlin2_sailor.inference.torch_export import save_torch_module
+
+        backbone = build_torch()
+        if not isinstance(backbone, TorchBackbone):
+            raise DependencyError(f"The {name} backbone is not a torch module and cannot be exported.")
+        size = backbone.input_size
         save_torch_module(backbone.feature_module(), torch.zeros(1, 3, size, size), [(-1, 3, size, size)],
                           target / MODEL_FILE, ["crops"])
         return {"backbone": name, "feature_dimension": backbone.feature_dimension, "input_size": size,
                 "mean": list(backbone.mean), "std": list(backbone.std)}
 
-    return store_exported(backbone_model_name(name), backbone_fingerprint(name, weights_path), write, folder)
-
-
-def ensure_backbone(name: str, build_torch: TorchBackboneFactory, weights_path: str = "",
-                    folder: Path | None = None, report: Callable[[str], None] | None = None) -> ExportedModel:
-    """The exported backbone, exporting it first (with one line through ``report``) when it is missing."""
-    exported = find_exported(backbone_model_name(name), backbone_fingerprint(name, weights_path), folder)
-    if exported is not None:
-        return exported
-    try:
-        import torch  # noqa: F401  (only to tell a missing export from a missing torch)
-    except ImportError as error:
-        raise DependencyError(
-            f"No exported {name} backbone in the model cache, and torch (needed to export it) is not installed. "
-            "Run `sailor export-models` on a machine with torch and point SAILOR_MODEL_CACHE at its output."
-        ) from error
-    started = time.monotonic()
-    exported = export_backbone(name, build_torch, weights_path, folder)
-    if report is not None:
-        report(f"exported the {name} backbone for OpenVINO in {time.monotonic() - started:.1f} s "
-               f"(once; cached in {exported.folder})")
-    return exported
+    return ensure_exported(backbone_model_name(name), backbone_fingerprint(name, weights_path), write,
+                           f"the {name} backbone", needs_torch=True, folder=folder, report=report)
 
 
 class OpenVinoBackbone(Backbone):

@@ -16,7 +16,6 @@ within 0.01).
 from __future__ import annotations
 
 import importlib.util
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,7 +24,7 @@ import numpy as np
 
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, DependencyError
-from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, find_exported, fingerprint, store_exported
+from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, ensure_exported, fingerprint
 from merlin2_sailor.inference.openvino_runtime import CompiledNetwork, openvino_core
 from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.box_overlap import suppress_cross_class_duplicates
@@ -102,10 +101,6 @@ def ensure_openvino_detector(directory: Path, input_size: int, folder: Path | No
                              report: Callable[[str], None] | None = None) -> ExportedModel:
     """The graph converted for OpenVINO with a fixed (1, S, S, 3) input, converting it first when missing."""
     graph = directory / GRAPH_FILE
-    model_fingerprint = fingerprint(f"input {input_size}", graph)
-    exported = find_exported(OPENVINO_MODEL_NAME, model_fingerprint, folder)
-    if exported is not None:
-        return exported
 
     def write(target: Path) -> dict[str, object]:
         import openvino
@@ -115,12 +110,8 @@ def ensure_openvino_detector(directory: Path, input_size: int, folder: Path | No
         openvino.save_model(model, str(target / MODEL_FILE), compress_to_fp16=False)
         return {"graph": str(graph), "input_size": input_size}
 
-    started = time.monotonic()
-    exported = store_exported(OPENVINO_MODEL_NAME, model_fingerprint, write, folder)
-    if report is not None:
-        report(f"converted the SSD-MobileNet graph for OpenVINO in {time.monotonic() - started:.1f} s "
-               f"(once; cached in {exported.folder})")
-    return exported
+    return ensure_exported(OPENVINO_MODEL_NAME, fingerprint(f"input {input_size}", graph), write,
+                           "the SSD-MobileNet graph", needs_torch=False, folder=folder, report=report)
 
 
 class SsdMobileNetDetector(Detector):
