@@ -52,6 +52,17 @@ def choose_device(requested: str, available: Sequence[str], report: Callable[[st
     return "CPU"
 
 
+def _configuration(settings: InferenceSettings, device: str) -> dict[str, object]:
+    """OpenVINO properties for ``device``: latency first, the precision asked for, the thread count
+    (a CPU property: a GPU runs on its own threads)."""
+    config: dict[str, object] = {"PERFORMANCE_HINT": "LATENCY"}
+    if settings.precision == "f32":
+        config["INFERENCE_PRECISION_HINT"] = "f32"
+    if settings.threads and device == "CPU":
+        config["INFERENCE_NUM_THREADS"] = settings.threads
+    return config
+
+
 class CompiledNetwork:
     """A model compiled for one device: call it with NumPy arrays, get its outputs as arrays.
 
@@ -64,12 +75,17 @@ class CompiledNetwork:
         core = openvino_core()
         report = report or _logger.warning
         self.device = choose_device(settings.device, core.available_devices, report)
-        config: dict[str, object] = {"PERFORMANCE_HINT": "LATENCY"}
-        if settings.precision == "f32":
-            config["INFERENCE_PRECISION_HINT"] = "f32"
-        if settings.threads and self.device == "CPU":
-            config["INFERENCE_NUM_THREADS"] = settings.threads
-        self._compiled = core.compile_model(str(model_path), self.device, config)
+        try:
+            self._compiled = core.compile_model(str(model_path), self.device, _configuration(settings, self.device))
+        except Exception as error:  # OpenVINO raises RuntimeError subclasses of its own
+            if self.device == "CPU":
+                raise DependencyError(
+                    f"OpenVINO could not load {model_path}: {' '.join(str(error).split())[:300]}. Delete that "
+                    "folder and run `sailor export-models`, or set inference_runtime to native.") from error
+            report(f"inference device {self.device} failed to load {model_path.parent.name} "
+                   f"({' '.join(str(error).split())[:200]}); running on the CPU")
+            self.device = "CPU"
+            self._compiled = core.compile_model(str(model_path), "CPU", _configuration(settings, "CPU"))
         self._request = self._compiled.create_infer_request()
         self._lock = threading.Lock()
         self.input_names = tuple(port.get_any_name() for port in self._compiled.inputs)
@@ -81,14 +97,6 @@ class CompiledNetwork:
             if name in names:
                 return index
         raise KeyError(f"the model has no output {name!r}")
-
-    @property
-    def precision(self) -> str:
-        """The precision the runtime computes in (``bf16``, ``f32``, ...)."""
-        try:
-            return str(self._compiled.get_property("INFERENCE_PRECISION_HINT")).rsplit(".", 1)[-1].lower()
-        except Exception:  # a device without the property
-            return "?"
 
     @property
     def threads(self) -> int:

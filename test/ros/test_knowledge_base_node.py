@@ -21,6 +21,10 @@ DECLARATIONS = [
 ]
 
 
+#: How long a (re)started node's services may take to be discovered on a loaded machine.
+DISCOVERY_SECONDS = 20.0
+
+
 def start_knowledge_base(node_process, namespace: str, store: str):
     return node_process("knowledge_base", "--ros-args", "-r", f"__ns:={namespace}", "-p", f"store:={store}")
 
@@ -78,11 +82,14 @@ def test_killed_at_random_moments_the_node_loses_no_acknowledged_write(tmp_path,
     acknowledged: list[str] = []  # symbols whose object and fact the node confirmed
     symbols: list[str] = []  # every symbol the writer tried to store
     client = open_store(f"ros://{namespace}")
-    client._timeout = 3.0  # noqa: SLF001 - a killed node must not stall the test for long
     try:
         for _round in range(3):
             process = start_knowledge_base(node_process, namespace, store)
+            # A restarted node's services can take seconds to be discovered on a loaded machine:
+            # wait for it as long as discovery may take, then keep calls short while it gets killed.
+            client._timeout = DISCOVERY_SECONDS  # noqa: SLF001
             client.apply(DECLARATIONS)
+            client._timeout = 3.0  # noqa: SLF001 - a killed node must not stall the test for long
             killer = threading.Timer(randomness.uniform(0.5, 1.5), process.process.kill)
             killer.start()
             while process.process.poll() is None:
@@ -97,6 +104,7 @@ def test_killed_at_random_moments_the_node_loses_no_acknowledged_write(tmp_path,
             killer.join()
             process.stop()
         survivor = start_knowledge_base(node_process, namespace, store)
+        client._timeout = DISCOVERY_SECONDS  # noqa: SLF001
         stored_objects = {item.name for item in client.objects.get_all()}
         stored_facts = [fact.objects[0] for fact in client.propositions.get_all()]
     finally:

@@ -93,3 +93,14 @@ def test_a_failed_export_leaves_nothing_that_looks_finished(tmp_path: Path) -> N
         store_exported("net", "abc", failing, tmp_path)
     assert find_exported("net", "abc", tmp_path) is None
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_damaged_export_is_one_clear_error_not_a_traceback(tmp_path: Path) -> None:
+    from merlin2_sailor.errors import DependencyError
+    from merlin2_sailor.inference.openvino_runtime import CompiledNetwork
+
+    model = tmp_path / "net-abc" / MODEL_FILE
+    model.parent.mkdir()
+    model.write_text("<net name='half written'")  # a disk filled up mid-export, say
+    with pytest.raises(DependencyError, match="could not load .*sailor export-models"):
+        CompiledNetwork(model, InferenceSettings(threads=1))

@@ -141,7 +141,8 @@ def test_the_fastest_precision_keeps_features_scores_and_detections_close() -> N
 
 RUNTIME_ONLY = textwrap.dedent("""
     import sys
-    sys.modules["torch"] = None  # a deployment without torch: any `import torch` fails
+    # A deployment without torch (nor the architecture package built on it): their imports fail.
+    sys.modules["torch"] = sys.modules["efficientnet_lite_pytorch"] = None
     import numpy as np
     from merlin2_sailor.anchoring.matcher_registry import MatcherSettings, create_matching
     from merlin2_sailor.errors import SailorError
