@@ -21,6 +21,8 @@ from typing import Any
 
 import pytest
 
+from merlin2_sailor.inference.model_cache import cache_folder
+
 REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
 
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
@@ -30,8 +32,7 @@ os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "c
 os.environ.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
 # Exported models are named by a hash of what they were exported from, so the run may share the
 # user's model cache (set-up fills it): it cannot read a stale model. Fixed before HOME moves.
-os.environ.setdefault("SAILOR_MODEL_CACHE", str(Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-                                                / "merlin2_sailor" / "models"))
+os.environ.setdefault("SAILOR_MODEL_CACHE", str(cache_folder()))
 # Nodes keep state under ~ (e.g. ~/.sailor/anchoring): tests must neither read a user's state
 # nor leave theirs behind, so this run gets a home of its own.
 os.environ["HOME"] = tempfile.mkdtemp(prefix="sailor-test-home-")

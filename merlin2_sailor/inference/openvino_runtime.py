@@ -88,7 +88,6 @@ class CompiledNetwork:
             self._compiled = core.compile_model(str(model_path), "CPU", _configuration(settings, "CPU"))
         self._request = self._compiled.create_infer_request()
         self._lock = threading.Lock()
-        self.input_names = tuple(port.get_any_name() for port in self._compiled.inputs)
         self._output_names = tuple(frozenset(port.get_names()) for port in self._compiled.outputs)
 
     def output_index(self, name: str) -> int:
