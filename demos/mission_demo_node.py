@@ -288,11 +288,14 @@ class MissionDemoNode(Node):
         object is named the same way, so the report can tell whose symbol went where."""
         time.sleep(SETTLE_SECONDS)  # the last look's anchors are confirmed a moment after it ends
         with self._lock:
-            # A missing anchor still names what the robot saw there: an anchor that went missing
-            # for a few frames as the look ended (three frames without the mug on a loaded
-            # machine, reacquired a moment later) is no reason to say the target was never anchored.
-            anchors = [a for a in self._anchors if a.state in CLAIMING_STATES]
-        self._symbols_before = associate(self._initial_truth, anchors)
+            confirmed = [a for a in self._anchors if a.state == "confirmed"]
+            missing = [a for a in self._anchors if a.state in CLAIMING_STATES and a.state != "confirmed"]
+        # Confirmed anchors are the fresher evidence; a missing anchor still names what the robot
+        # saw there, so it names an object no confirmed anchor does (the mug's anchor missing for
+        # three frames as the look ended, on a loaded machine, reacquired a moment later).
+        self._symbols_before = associate(self._initial_truth, confirmed)
+        unnamed = [obj for obj in self._initial_truth if obj.id not in self._symbols_before]
+        self._symbols_before.update(associate(unnamed, missing))
         symbol = self._symbols_before.get(self._target)
         self._say(f"the {self._target.replace('_', ' ')} is anchored as {symbol}" if symbol
                   else f"the {self._target.replace('_', ' ')} was not anchored while exploring")
