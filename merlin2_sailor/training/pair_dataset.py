@@ -33,13 +33,25 @@ pair metrics count them apart).
 Replaced pairs: the same lesson without a search. An object swapped with, or replaced by,
 another of its class that looks different stands exactly where the anchor was; a network that
 has only seen searched pairs uses appearance only when searching, and takes a green mug in the
-red mug's place for the red mug (score 1.0, measured). With ``replaced_pairs_per_positive``,
-each scene adds that many copies per positive pair of its same-class false pairs (never of two
-twins, which nothing could tell apart), with the percept moved to within a few centimetres of
-the anchor's place; ``replaced`` marks them, and the pair metrics count them apart too. Their
-share is a balance: at 2 per positive pair the network doubted place itself (8 duplicate
-anchors in one scenario run); at 0.5 it still took a green mug in the red mug's place for the
-red one, but less surely (0.72 instead of 1.0).
+red mug's place for the red mug (score 1.0, measured). So each scene adds copies of its
+same-class false pairs (never of two twins, which nothing could tell apart) with the percept
+moved to within a few centimetres of the anchor's place; ``replaced`` marks them, and the pair
+metrics count them apart too.
+
+A replacement happens while the camera looks elsewhere, so a replaced pair's anchor was last
+seen a while before (``replaced_absence``, log-uniform seconds), never the fraction of a second
+between two frames that the false pair it copies may have had; and what it competes with is a
+revisit, the same object seen again after such an absence, so there are
+``replaced_pairs_per_revisit`` of them per true pair with that long a gap. Both choices were
+measured by replaying the anchoring layer over the 10 held-out houses (167 objects). Copied with
+their own short gaps, at 0.5 per positive pair, the replaced pairs taught the network that an
+object in the very place of an anchor seen a frame ago may be another one: 223 anchors, 141
+identity switches; 52 of the 56 extra anchors were views rejected at the anchor's own place
+(0.0-0.2 m), 13 of them a third of a second after it was last seen. Given long gaps but still
+counted per positive pair (nearly all of which are a frame apart), they outnumbered the revisits
+several times, and the network doubted every revisit instead: 237 anchors. Counted per revisit:
+0.5 gives 181 anchors and 33 switches, 1 gives 199 and 63, 2 gives 218 and 91. (Searched pairs
+given such gaps too changed nothing measurable: 181 anchors, 39 switches.)
 
 Class-balanced sampling (for training only; evaluation uses every pair): pairs of different
 classes are trivial negatives and dwarf the rest, so they are subsampled to at most
@@ -68,15 +80,18 @@ class PairDatasetConfig:
     """``chunk_pairs``: pairs per chunk; ``different_class_per_positive``: None keeps every pair,
     a number enables class-balanced sampling (see the module docstring); ``look_alike_distance``
     (m): a same-class pair nearer than this is a look-alike case (class and position agree, only
-    appearance or the ground truth can tell); ``search_pairs_per_positive``,
-    ``replaced_pairs_per_positive``: searched and replaced pairs added (see the module docstring;
-    0 adds none); ``seed``: for the subsampling."""
+    appearance or the ground truth can tell); ``search_pairs_per_positive``: searched pairs added
+    per positive pair, ``replaced_pairs_per_revisit``: replaced pairs added per revisit (a positive
+    pair whose anchor was last seen at least the shortest ``replaced_absence`` before), see the
+    module docstring (0 adds none); ``replaced_absence`` (s): the range, log-uniform, of how long
+    before a replaced pair's percept its anchor was last seen; ``seed``: for the subsampling."""
 
     chunk_pairs: int = 4096
     different_class_per_positive: float | None = None
     look_alike_distance: float = 1.0
     search_pairs_per_positive: float = 1.0
-    replaced_pairs_per_positive: float = 0.5
+    replaced_pairs_per_revisit: float = 0.5
+    replaced_absence: tuple[float, float] = (20.0, 600.0)
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -85,9 +100,15 @@ class PairDatasetConfig:
         ratio = self.different_class_per_positive
         if ratio is not None and not (math.isfinite(ratio) and ratio >= 0.0):
             raise ConfigurationError(f"different_class_per_positive must be None or >= 0, got {ratio}.")
-        for name in ("search_pairs_per_positive", "replaced_pairs_per_positive"):
+        for name in ("search_pairs_per_positive", "replaced_pairs_per_revisit"):
             if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0.0):
                 raise ConfigurationError(f"{name} must be >= 0, got {getattr(self, name)}.")
+        shortest, longest = self.replaced_absence
+        if not (math.isfinite(shortest) and math.isfinite(longest) and 0.0 < shortest <= longest):
+            raise ConfigurationError(
+                f"replaced_absence must be (shortest, longest) seconds with 0 < shortest <= longest, "
+                f"got {self.replaced_absence}."
+            )
         if not (math.isfinite(self.look_alike_distance) and self.look_alike_distance > 0.0):
             raise ConfigurationError(
                 f"look_alike_distance must be a positive distance, got {self.look_alike_distance}."
@@ -307,7 +328,8 @@ def _replaced(chunk: PairChunk, config: PairDatasetConfig, scene_id: str) -> Pai
     """Replaced copies of some of the scene's same-class false pairs, twins excepted: the percept
     stands where the anchor was (see the module docstring)."""
     rows = np.flatnonzero(~chunk.labels & (chunk.percept_classes == chunk.anchor_classes) & ~chunk.twins)
-    count = min(int(round(config.replaced_pairs_per_positive * int(chunk.labels.sum()))), len(rows))
+    revisits = chunk.labels & (chunk.percept_stamps - chunk.anchor_last_seen >= config.replaced_absence[0])
+    count = min(int(round(config.replaced_pairs_per_revisit * int(revisits.sum()))), len(rows))
     if count == 0:
         return chunk.take(slice(0, 0))
     seed = int.from_bytes(hashlib.sha256(f"{config.seed}|replace|{scene_id}".encode()).digest()[:8], "little")
@@ -318,8 +340,11 @@ def _replaced(chunk: PairChunk, config: PairDatasetConfig, scene_id: str) -> Pai
     positions = replaced.anchor_positions.copy()
     positions[:, 0] += offset * np.cos(angle)
     positions[:, 1] += offset * np.sin(angle)
-    return dataclasses.replace(replaced, percept_positions=positions, replaced=np.ones(count, dtype=bool),
-                               look_alike=np.zeros(count, dtype=bool))
+    shortest, longest = config.replaced_absence
+    absence = np.exp(rng.uniform(math.log(shortest), math.log(longest), size=count))
+    return dataclasses.replace(replaced, percept_positions=positions,
+                               anchor_last_seen=replaced.percept_stamps - absence,
+                               replaced=np.ones(count, dtype=bool), look_alike=np.zeros(count, dtype=bool))
 
 
 def _padded(ids: np.ndarray, width: int) -> np.ndarray:

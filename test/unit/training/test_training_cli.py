@@ -40,9 +40,13 @@ def test_train_then_evaluate_a_few_scenes(tmp_path, capsys) -> None:
     # The anchoring node's settings, with the command line's: both matchers are judged at them.
     assert "threshold 0.6" in output and report["anchoring_settings"]["match_threshold"] == 0.6
     assert report["anchoring_settings"]["weights"] == str(weights)
-    assert set(report["pairs"]) == {"network", "rules", "network look-alike", "rules look-alike",
-                                    "network partial view", "rules partial view", "network searched",
-                                    "rules searched", "network replaced", "rules replaced"}
+    # Replaced pairs copy revisits (an object seen again 20 s or more later), which a single
+    # generated scene may not hold; when there are some, both matchers are scored on them.
+    replaced = {"network replaced", "rules replaced"}
+    assert set(report["pairs"]) - replaced == {"network", "rules", "network look-alike", "rules look-alike",
+                                               "network partial view", "rules partial view", "network searched",
+                                               "rules searched"}
+    assert len(set(report["pairs"]) & replaced) in (0, 2)
     assert (tmp_path / "eval" / "confusion.png").is_file()
 
 

@@ -134,7 +134,7 @@ def test_crops_are_the_2d_boxes_clipped_to_the_image(motfront) -> None:
 
 def test_pairs_follow_algorithm_3(motfront) -> None:
     source = MotFrontSource(MotFrontConfig(root=str(motfront)))
-    algorithm_3 = PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_positive=0.0)  # the paper's only
+    algorithm_3 = PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_revisit=0.0)  # the paper's only
     pairs = PairChunk.concatenate(list(iter_pair_chunks(source.scenes(ALL, 10), algorithm_3)))
     # seq_a: 2, 3, 3 objects -> 0 + 3x2 + 3x3 = 15 pairs, 2 + 3 = 5 positives; seq_b: 0 + 2x1 = 2, 1.
     counts = {s: (int((pairs.scene_ids == s).sum()), int(pairs.labels[pairs.scene_ids == s].sum()))

@@ -212,7 +212,7 @@ def test_crops_are_cut_where_the_boxes_project(nuscenes) -> None:
 def test_pairs_follow_algorithm_3(nuscenes) -> None:
     root, _ = nuscenes
     source = NuScenesSource(NuScenesConfig(dataroot=str(root)))
-    algorithm_3 = PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_positive=0.0)  # the paper's only
+    algorithm_3 = PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_revisit=0.0)  # the paper's only
     pairs = PairChunk.concatenate(list(iter_pair_chunks(source.scenes(ALL, 10), algorithm_3)))
     # Scene A: 2 objects in each of 3 samples -> 0 + 2x2 + 2x2 = 8 pairs, 4 positives.
     # Scene B: 2, 3, 3 objects (the truck joins) -> 0 + 3x2 + 3x3 = 15 pairs, 5 positives.

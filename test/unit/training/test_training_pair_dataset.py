@@ -17,7 +17,7 @@ from merlin2_sailor.training.pair_dataset import REPLACED_OFFSET, PairDatasetCon
 from .conftest import hand_scene, observation
 
 #: Only Algorithm 3's own pairs: no searched or replaced pairs beside them.
-ALGORITHM_3_ONLY = {"search_pairs_per_positive": 0.0, "replaced_pairs_per_positive": 0.0}
+ALGORITHM_3_ONLY = {"search_pairs_per_positive": 0.0, "replaced_pairs_per_revisit": 0.0}
 
 
 def test_one_new_object_per_sample_gives_n_times_n_minus_one_over_two_pairs() -> None:
@@ -168,7 +168,7 @@ def test_searched_pairs_copy_true_and_false_pairs_with_a_radius_that_covers_them
                         [observation(0, 1, position=(0.02, 0, 0)), observation(1, 1, position=(3.01, 0, 0))]])
     plain = scene_pairs(scene, PairDatasetConfig(**ALGORITHM_3_ONLY))
     assert not plain.searched.any() and len(plain) == 4
-    chunk = scene_pairs(scene, PairDatasetConfig(search_pairs_per_positive=1.0, replaced_pairs_per_positive=0.0))
+    chunk = scene_pairs(scene, PairDatasetConfig(search_pairs_per_positive=1.0, replaced_pairs_per_revisit=0.0))
     searched = chunk.take(chunk.searched)
     assert len(chunk) == len(plain) + len(searched) and len(searched) == 2
     assert searched.labels.tolist().count(True) == 1  # half true, half same-class false
@@ -189,7 +189,7 @@ def test_replaced_pairs_put_another_object_of_the_class_where_the_anchor_stood_b
                          observation(2, 1, position=(6, 0, 0), stamp=20.0, twin=True),
                          observation(3, 1, position=(9, 0, 0), stamp=20.0, twin=True)]])
     plain = scene_pairs(scene, PairDatasetConfig(**ALGORITHM_3_ONLY))
-    chunk = scene_pairs(scene, PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_positive=10.0))
+    chunk = scene_pairs(scene, PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_revisit=10.0))
     replaced = chunk.take(chunk.replaced)
     false_same_class = int((~plain.labels & (plain.percept_classes == plain.anchor_classes) & ~plain.twins).sum())
     assert len(replaced) == false_same_class == 12 - 2  # every false pair but the two between the twins
@@ -199,6 +199,38 @@ def test_replaced_pairs_put_another_object_of_the_class_where_the_anchor_stood_b
     assert np.all(offsets <= REPLACED_OFFSET + 1e-9)  # where the anchor stood, not where the percept was
     features = replaced.features(FeatureConfig())
     assert not features.searched.any() and np.all(features.distance <= REPLACED_OFFSET + 1e-9)
-    # the percept keeps its own crop, size and time: only its place is the anchor's
+    # the percept keeps its own crop, size and time: only its place (and its anchor's last sighting) change
     originals = {(p, a) for p, a in zip(plain.percept_crop_ids, plain.anchor_crop_ids, strict=True)}
     assert all((p, a) in originals for p, a in zip(replaced.percept_crop_ids, replaced.anchor_crop_ids, strict=True))
+
+
+def test_a_replaced_pairs_anchor_was_last_seen_a_while_before_never_a_frame_ago() -> None:
+    # Frames a third of a second apart, then the robot comes back after a minute: the false pairs
+    # copied are mostly a frame apart in time, and the last frame's true pairs are revisits.
+    stamps = [0.0, 1 / 3, 2 / 3, 1.0, 61.0]
+    samples = [[observation(k, s, position=(3.0 * k, 0, 0), stamp=stamp) for k in range(4)]
+               for s, stamp in enumerate(stamps)]
+    plain = scene_pairs(hand_scene(samples), PairDatasetConfig(**ALGORITHM_3_ONLY))
+    assert np.median(plain.percept_stamps - plain.anchor_last_seen) < 0.7
+    config = PairDatasetConfig(search_pairs_per_positive=0.0, replaced_pairs_per_revisit=5.0,
+                               replaced_absence=(20.0, 600.0))
+    replaced = scene_pairs(hand_scene(samples), config).take(slice(len(plain), None))
+    assert replaced.replaced.all() and len(replaced) == 5 * 4  # the 4 revisits of the last frame
+    absence = replaced.percept_stamps - replaced.anchor_last_seen
+    assert absence.min() >= 20.0 and absence.max() <= 600.0
+    assert absence.max() > 100.0  # spread over the range (log-uniform), not piled at its start
+    features = replaced.features(FeatureConfig())
+    np.testing.assert_allclose(features.time_difference, absence)
+
+
+def test_without_revisits_there_are_no_replaced_pairs() -> None:
+    samples = [[observation(k, s, position=(3.0 * k, 0, 0), stamp=s / 3) for k in range(3)] for s in range(4)]
+    chunk = scene_pairs(hand_scene(samples), PairDatasetConfig(search_pairs_per_positive=0.0,
+                                                                replaced_pairs_per_revisit=5.0))
+    assert not chunk.replaced.any()
+
+
+@pytest.mark.parametrize("absence", [(0.0, 10.0), (30.0, 20.0), (5.0, float("inf"))])
+def test_a_replaced_absence_that_is_not_a_range_of_seconds_is_refused(absence: tuple[float, float]) -> None:
+    with pytest.raises(ConfigurationError, match="replaced_absence"):
+        PairDatasetConfig(replaced_absence=absence)
