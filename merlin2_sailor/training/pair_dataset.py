@@ -47,7 +47,7 @@ measured by replaying the anchoring layer over the 10 held-out houses (167 objec
 their own short gaps, at 0.5 per positive pair, the replaced pairs taught the network that an
 object in the very place of an anchor seen a frame ago may be another one: 223 anchors, 141
 identity switches; 52 of the 56 extra anchors were views rejected at the anchor's own place
-(0.0-0.2 m), 13 of them a third of a second after it was last seen. Given long gaps but still
+(0.0-0.2 m), 15 of them a third of a second after it was last seen. Given long gaps but still
 counted per positive pair (nearly all of which are a frame apart), they outnumbered the revisits
 several times, and the network doubted every revisit instead: 237 anchors. Counted per revisit:
 0.5 gives 181 anchors and 33 switches, 1 gives 199 and 63, 2 gives 218 and 91. (Searched pairs
