@@ -17,6 +17,7 @@ from enum import Enum
 
 import numpy as np
 
+from merlin2_sailor.anchoring.colour_evidence import ColourModel, combined, with_view
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
 from merlin2_sailor.anchoring.gallery import add_to_gallery, from_bfloat16_bits
@@ -62,6 +63,8 @@ class Anchor:
     gallery: np.ndarray | None = None
     """(n, D) recent appearance embeddings as bfloat16 bits (:mod:`.gallery`), newest last; None
     before any was available."""
+    colour: ColourModel | None = None
+    """The colours of its whole views' own pixels (:mod:`.colour_evidence`); None before any."""
     visible: bool = False
     """Reacquired or acquired in the latest processed frame."""
     missed_frames: int = 0
@@ -109,6 +112,7 @@ class Anchor:
             position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
             whole_views=0 if partial else 1,
             gallery=None if embedding is None else add_to_gallery(None, embedding, config.gallery_size),
+            colour=None if partial else with_view(None, percept.colour),
             visible=True,
             perceived_position=position.copy(),
         )
@@ -132,6 +136,7 @@ class Anchor:
         if not partial:
             self.whole_views += 1
             self.size = fuse_size(self.size, percept.size, self.whole_views, config)
+            self.colour = with_view(self.colour, percept.colour)
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
         if embedding is not None:
@@ -165,6 +170,7 @@ class Anchor:
         if other.gallery is not None:
             for view in from_bfloat16_bits(other.gallery):
                 self.gallery = add_to_gallery(self.gallery, view, config.gallery_size)
+        self.colour = combined(self.colour, other.colour)
         self.times_seen += other.times_seen
         self.last_seen = max(self.last_seen, other.last_seen)
         self.last_tracker_id = other.last_tracker_id or self.last_tracker_id

@@ -28,6 +28,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex, IndexConfig
 from merlin2_sailor.anchoring.assignment import assign
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
@@ -64,13 +65,16 @@ class AnchoringConfig:
     merge needs; ``world_frame``: the fixed frame percepts must be expressed in;
     ``expectation_tolerance`` (m): how close to an expected place a reacquired object must be to
     confirm the expectation (farther retracts it), also added to a search's radius;
-    ``repair``: when a newer anchor is a lost one seen again (:mod:`.identity_repair`).
+    ``repair``: when a newer anchor is a lost one seen again (:mod:`.identity_repair`);
+    ``colour``: when colours rule out that a view or an anchor is another anchor's object
+    (:mod:`.colour_evidence`), in the matching table and in every merge.
     """
 
     match_threshold: float = 0.5
     world_frame: str = "map"
     expectation_tolerance: float = 1.0
     repair: RepairConfig = field(default_factory=RepairConfig)
+    colour: ColourEvidenceConfig = field(default_factory=ColourEvidenceConfig)
     table: MatchingTableConfig = field(default_factory=MatchingTableConfig)
     fusion: FusionConfig = field(default_factory=FusionConfig)
     partial_view: PartialViewConfig = field(default_factory=PartialViewConfig)
@@ -122,9 +126,10 @@ class Anchoring:
         counter = SymbolCounter()
         self._own_counter: SymbolCounter | None = counter if symbol_factory is None else None
         self._new_symbol: SymbolFactory = symbol_factory or counter
-        self._table_builder = MatchingTableBuilder(self.matcher, self.config.table, embedder)
+        self._table_builder = MatchingTableBuilder(self.matcher, self.config.table, embedder, self.config.colour)
         self._repair = IdentityRepair(
-            self.matcher, self.config.match_threshold, self.config.repair, self.config.expectation_tolerance
+            self.matcher, self.config.match_threshold, self.config.repair, self.config.expectation_tolerance,
+            self.config.colour,
         )
         self._index = AnchorIndex(self.config.index)
         self._latest_stamp = -math.inf
@@ -177,11 +182,13 @@ class Anchoring:
         forget_expired(self._index, changes, self.config.lifecycle)
         previously_visible = self._index.visible()
 
-        table = self._table_builder.build(percepts, self._index)
+        partial = partial_views(percepts, camera, self.config.partial_view)
+        # Without a camera nothing says which views are whole, so no single view is colour evidence.
+        whole = None if camera is None else [not flag for flag in partial]
+        table = self._table_builder.build(percepts, self._index, whole)
         percepts = table.percepts
         assignment = assign(table.scores, self.config.match_threshold)
         symbols = [""] * len(percepts)
-        partial = partial_views(percepts, camera, self.config.partial_view)
         config = self.config
         for row, column in assignment.matches:
             anchor = table.anchors[column]

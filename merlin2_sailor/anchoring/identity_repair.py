@@ -15,13 +15,17 @@ Every decision here is pure: it reads anchors and the anchor index and returns a
 several anchors it is), or nothing. The coordinator (:class:`~.anchoring.Anchoring`) applies them.
 
 The evidence is the matching function itself (:func:`~.anchor_comparison.identity_scores`): the
-learned matcher compares appearance, so a mug of another colour is never merged into a missing
-mug's symbol; the rules compare only class, place and time. Besides a score at or above the
-match threshold, a candidate must be possible at all:
+learned matcher compares appearance; the rules compare only class, place and time. Besides a
+score at or above the match threshold, a candidate must be possible at all:
 
 - same class, nothing expected of it, trusted (confirmed, or confirmed once and missing again);
 - born no earlier than the lost anchor's last sighting before it went missing: two anchors seen
-  side by side at one time are two objects, whatever they look like.
+  side by side at one time are two objects, whatever they look like;
+- not of another colour: the colours of the two anchors' own pixels do not rule it out
+  (:mod:`.colour_evidence`; the rules have no other appearance, and the learned matcher's is
+  fooled by a look-alike where the lost one stood). A mug of another colour found where the red
+  mug is sought is never taken for it, with either matcher: the red mug stays missing, and a
+  search reports it not found.
 
 A candidate is taken only when it is clearly the best (by ``ambiguity_margin``) for the lost
 anchor, *and* the lost anchor is clearly the best of every other MISSING anchor the candidate
@@ -40,6 +44,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.matcher import Matcher
@@ -95,10 +100,13 @@ Decision = Merge | Undecided
 
 
 class IdentityRepair:
-    """Decides merges with one matcher, one match threshold and one :class:`RepairConfig`."""
+    """Decides merges with one matcher, one match threshold, one :class:`RepairConfig` and one
+    colour evidence configuration."""
 
-    def __init__(self, matcher: Matcher, match_threshold: float, config: RepairConfig, search_tolerance: float) -> None:
+    def __init__(self, matcher: Matcher, match_threshold: float, config: RepairConfig, search_tolerance: float,
+                 colour: ColourEvidenceConfig | None = None) -> None:
         self.matcher = matcher
+        self.colour = colour or ColourEvidenceConfig()
         self.match_threshold = match_threshold
         self.config = config
         self.search_tolerance = search_tolerance
@@ -204,8 +212,7 @@ class IdentityRepair:
             > max(own - self.config.ambiguity_margin, self.match_threshold - 1e-12)
         ]
 
-    @staticmethod
-    def _possible(candidate: Anchor, lost: Anchor, include_missing: bool) -> bool:
+    def _possible(self, candidate: Anchor, lost: Anchor, include_missing: bool) -> bool:
         """Whether ``candidate`` can be ``lost`` at all (before any score): see the module docstring."""
         allowed = (AnchorState.CONFIRMED, AnchorState.MISSING) if include_missing else (AnchorState.CONFIRMED,)
         last_sighting = lost.lost_after if lost.lost_after is not None else lost.last_seen
@@ -215,6 +222,7 @@ class IdentityRepair:
             and candidate.state in allowed
             and candidate.expectation is None
             and candidate.first_seen >= last_sighting
+            and not colours_differ(candidate.colour, lost.colour, self.colour)
         )
 
     def _near(self, anchor: Anchor, index: AnchorIndex) -> list[Anchor]:

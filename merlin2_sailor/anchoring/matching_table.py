@@ -20,7 +20,10 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    (which is what spares its crop from the backbone) and the pair scores
    ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
    floor; a class mismatch never is;
-4. **one vectorised feature computation and one matcher call** for all remaining pairs.
+4. **one vectorised feature computation and one matcher call** for all remaining pairs;
+5. **colour evidence**: a whole view whose colour rules out an anchor unseen for a while (a
+   look-alike of another colour put in its place) is gated from it, whatever the matcher scored
+   (:func:`~.colour_evidence.view_differs`).
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, view_differs
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.contract.percept import Percept
@@ -135,18 +139,24 @@ class MatchingTableBuilder:
     """Builds :class:`MatchingTable` s with one matcher, one configuration, one optional embedder."""
 
     def __init__(
-        self, matcher: Matcher, config: MatchingTableConfig | None = None, embedder: Embedder | None = None
+        self, matcher: Matcher, config: MatchingTableConfig | None = None, embedder: Embedder | None = None,
+        colour: ColourEvidenceConfig | None = None,
     ) -> None:
         self.matcher = matcher
         self.config = config or MatchingTableConfig()
         self.embedder = embedder
+        self.colour = colour or ColourEvidenceConfig()
 
     def gate_radius(self, elapsed: np.ndarray | float) -> np.ndarray:
         """How far an anchor unseen for ``elapsed`` seconds may be from a percept of it."""
         elapsed = np.maximum(np.asarray(elapsed, dtype=np.float64), 0.0)
         return np.minimum(self.config.base_gate + self.config.maximum_speed * elapsed, self.config.maximum_gate)
 
-    def build(self, percepts: Sequence[Percept], index: AnchorIndex) -> MatchingTable:
+    def build(
+        self, percepts: Sequence[Percept], index: AnchorIndex, whole: Sequence[bool] | None = None
+    ) -> MatchingTable:
+        """``whole``: per percept, whether it shows its whole object (None: not known), so that
+        its colour may count as evidence."""
         percepts = tuple(percepts)
         columns = PerceptColumns.from_percepts(percepts)
         pair_rows, pair_slots = self._ungated_pairs(columns, index)
@@ -198,6 +208,11 @@ class MatchingTableBuilder:
             scores[searched] = np.minimum(scores[searched], self.config.search_score_cap)
         scores[shortcut] = np.where(eligible[shortcut], self.config.tracker_continuity_score, self.config.gated_score)
         scores = apply_tracker_continuity(scores, continuations, same_class, self.config.tracker_continuity_score)
+        if whole is not None:
+            ruled_out = self._ruled_out_by_colour(percepts, anchors, anchor_columns.last_seen, whole, ~gated)
+            scores[ruled_out] = self.config.gated_score
+            gated |= ruled_out
+            continuations &= ~ruled_out
         return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded)
 
     def _ungated_pairs(self, percepts: PerceptColumns, index: AnchorIndex) -> tuple[np.ndarray, np.ndarray]:
@@ -224,6 +239,21 @@ class MatchingTableBuilder:
         if self.config.gate_class_mismatch:
             passing &= percepts.class_names[rows] == index.class_names_of(slots)
         return rows[passing], slots[passing]
+
+    def _ruled_out_by_colour(
+        self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], last_seen: np.ndarray,
+        whole: Sequence[bool], open_pairs: np.ndarray,
+    ) -> np.ndarray:
+        """(P, A) pairs whose percept, a whole view, is of another colour than its anchor, unseen
+        for the configured absence."""
+        ruled_out = np.zeros(open_pairs.shape, dtype=bool)
+        if self.colour.minimum_views == 0:
+            return ruled_out
+        for row, column in zip(*np.nonzero(open_pairs), strict=True):
+            percept = percepts[row]
+            if whole[row] and percept.stamp - last_seen[column] >= self.colour.absence:
+                ruled_out[row, column] = view_differs(anchors[column].colour, percept.colour, self.colour)
+        return ruled_out
 
     def _embed_needed(self, percepts: tuple[Percept, ...], rows: np.ndarray) -> tuple[tuple[Percept, ...], int]:
         """Embed, in one call, the crops of the given percepts that have none yet."""

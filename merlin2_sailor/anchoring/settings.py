@@ -323,6 +323,19 @@ SETTINGS: tuple[Setting, ...] = (
                 "How much better than every rival a candidate for a merge must score to be taken (scores "
                 "closer than this cannot tell two look-alikes apart: nothing is merged, and it is said).",
                 0.0, 0.99),
+        Setting("colour_minimum_views", ("core", "colour", "minimum_views"),
+                "Whole views each of two anchors needs before their colours (of the object's own pixels) "
+                "may rule out that they are one object (0 turns colour evidence off).", 0, 1000),
+        Setting("colour_minimum_difference", ("core", "colour", "minimum_difference"),
+                "Share of an object's pixels by which one 60-degree hue window (or a grey level) of two "
+                "anchors must differ to rule out a merge (a red mug's red is about 0.12-0.2).", 0.001, 0.999),
+        Setting("colour_noise_factor", ("core", "colour", "noise_factor"),
+                "How many standard deviations of the two anchors' own views that difference must also "
+                "exceed (views of one object vary with light and angle).", 0.0, 100.0),
+        Setting("colour_absence", ("core", "colour", "absence"),
+                "Seconds an anchor must have gone unseen before one whole view of another colour rules "
+                "out that it is the anchor's object (a look-alike put in its place while the camera looked "
+                "away); 0: always.", 0.0, 1e6),
     ),
     *_group(
         "Spatial index (performance only)",

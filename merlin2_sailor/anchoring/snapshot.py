@@ -15,10 +15,12 @@ from typing import Any
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.colour_evidence import ColourModel
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.gallery import GALLERY_DTYPE
 from merlin2_sailor.errors import InvalidInputError
 from merlin2_sailor.knowledge.model import Provenance
+from merlin2_sailor.perception.colour_histogram import COLOUR_BINS
 
 #: Identifies a snapshot; restore refuses anything else.
 SNAPSHOT_FORMAT = "merlin2_sailor.anchors"
@@ -49,6 +51,9 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "class_votes": {name: float(votes) for name, votes in anchor.class_votes.items()},
         "position_variance": float(anchor.position_variance),
         "gallery": gallery,
+        "colour": None if anchor.colour is None else {
+            "views": int(anchor.colour.views), "mean": anchor.colour.mean.tolist(),
+            "squares": anchor.colour.squares.tolist()},
         "missed_frames": int(anchor.missed_frames),
         "recovery_sightings": int(anchor.recovery_sightings),
         "missing_since": anchor.missing_since,
@@ -78,6 +83,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             class_votes={str(k): float(v) for k, v in dict(data.get("class_votes") or {}).items()},
             position_variance=float(data["position_variance"]),
             gallery=_gallery(data.get("gallery")),
+            colour=_colour(data.get("colour")),
             visible=False,
             missed_frames=int(data.get("missed_frames", 0)),
             recovery_sightings=int(data.get("recovery_sightings", 0)),
@@ -102,6 +108,19 @@ def _vector(values: Any, name: str) -> np.ndarray:
     if vector.shape != (3,) or not np.all(np.isfinite(vector)):
         raise ValueError(f"{name} must be 3 finite numbers, got {values!r}")
     return vector
+
+
+def _colour(data: Mapping[str, Any] | None) -> ColourModel | None:
+    """A snapshot's colour model (None in snapshots written before anchors had one)."""
+    if data is None:
+        return None
+    mean = np.asarray(data["mean"], dtype=np.float64)
+    squares = np.asarray(data["squares"], dtype=np.float64)
+    views = int(data["views"])
+    if views < 1 or mean.shape != (COLOUR_BINS,) or squares.shape != (COLOUR_BINS,) \
+            or not (np.all(np.isfinite(mean)) and np.all(np.isfinite(squares))):
+        raise ValueError(f"colour must hold views >= 1 and {COLOUR_BINS} finite means and squares")
+    return ColourModel(views, mean, squares)
 
 
 def _gallery(data: Mapping[str, Any] | None) -> np.ndarray | None:

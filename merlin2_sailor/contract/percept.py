@@ -52,6 +52,10 @@ class Percept:
     when the tracker gave none; an empty id is never evidence of identity. ``crop`` is the RGB
     image patch (H x W x 3, uint8) inside ``box``; the anchoring layer decides whether it needs
     embedding. ``embedding`` is filled only when a crop was already embedded upstream.
+    ``colour`` is the colour histogram of the object's own pixels (those its 3D box was measured
+    on, not the background its 2D box also covers; see
+    :func:`~merlin2_sailor.perception.colour_histogram.colour_histogram`), or None when unknown:
+    the appearance evidence every matcher can afford, since it needs no network.
     """
 
     class_name: str
@@ -65,3 +69,4 @@ class Percept:
     class_id: int = -1
     frame_id: str = "map"
     embedding: np.ndarray | None = None
+    colour: np.ndarray | None = None

@@ -117,7 +117,9 @@ class Box3D:
 
     ``center`` and ``size`` are in metres in the world frame; ``center_depth`` is the robust
     camera-frame depth of the object (useful for occlusion tests and logs); ``point_count`` is
-    how many depth pixels the box was built from.
+    how many depth pixels the box was built from; ``pixels`` marks them, (h, w) boolean over the
+    detection's pixel window: the object's own pixels, without the background the 2D box also
+    covers (what the object's colour is read from, see the percept generator).
     """
 
     index: int
@@ -125,6 +127,7 @@ class Box3D:
     size: np.ndarray
     center_depth: float
     point_count: int
+    pixels: np.ndarray
 
 
 Box3DResult = Box3D | Rejection
@@ -300,6 +303,7 @@ def _estimate_one(
         size=upper - lower,
         center_depth=center_depth,
         point_count=band_count,
+        pixels=band,
     )
 
 

@@ -30,6 +30,7 @@ from merlin2_sailor.perception.box3d import (
     estimate_boxes_from_depth,
     estimate_boxes_from_points,
 )
+from merlin2_sailor.perception.colour_histogram import object_colour
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.pixel_window import pixel_window
 
@@ -158,6 +159,7 @@ class PerceptGenerator:
                 dropped.append(DroppedDetection(detection, RejectionReason.OUTSIDE_IMAGE, "box covers no pixel"))
                 continue
             x_min, y_min, x_max, y_max = detection.box.corners
+            crop = image[window.slices]
             percepts.append(
                 Percept(
                     class_name=detection.class_name,
@@ -168,10 +170,11 @@ class PerceptGenerator:
                     position=result.center,
                     size=result.size,
                     stamp=float(stamp),
-                    crop=image[window.slices].copy(),
+                    crop=crop.copy(),
                     tracker_id=detection.tracker_id,
                     class_id=detection.class_id,
                     frame_id=self.config.world_frame,
+                    colour=object_colour(crop, result.pixels),
                 )
             )
         return PerceptBatch(tuple(percepts), tuple(dropped))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -16,6 +17,7 @@ from visualization_msgs.msg import Marker
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.perception.colour_histogram import COLOUR_BINS
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.ros.conversions import (
     array_to_image,
@@ -128,7 +130,10 @@ def test_a_well_formed_detection_message_is_accepted() -> None:
 
 
 def test_percept_array_round_trip_keeps_every_field_and_the_crop() -> None:
-    percepts = [make_percept(), make_percept((0, 0), tracker_id="", class_name="dog")]
+    colour = np.zeros(COLOUR_BINS, dtype=np.float32)
+    colour[[3, 19]] = (0.25, 0.75)
+    percepts = [dataclasses.replace(make_percept(), colour=colour),
+                make_percept((0, 0), tracker_id="", class_name="dog")]
     header = Header(stamp=seconds_to_stamp(1712.125), frame_id="map")
     message = percepts_to_message(percepts, header)
     assert message.percepts[0].crop.encoding == "rgb8" and message.percepts[1].crop.width == 0
@@ -141,6 +146,8 @@ def test_percept_array_round_trip_keeps_every_field_and_the_crop() -> None:
         np.testing.assert_array_equal(copy.size, original.size)
         np.testing.assert_array_equal(copy.crop, original.crop)
         assert copy.crop.dtype == np.uint8 and copy.crop.shape[2:] == (3,)
+    np.testing.assert_array_equal(restored[0].colour, colour)
+    assert restored[1].colour is None
 
 
 def test_percepts_of_another_frame_cannot_be_published_in_this_one() -> None:
@@ -156,6 +163,9 @@ def test_percepts_of_another_frame_cannot_be_published_in_this_one() -> None:
         (lambda m: setattr(m.percepts[0], "score", 2.0), "not in \\[0, 1\\]"),
         (lambda m: setattr(m.percepts[0], "crop", array_to_image(np.zeros((2, 2), np.uint8), "mono8")), "rgb8"),
         (lambda m: setattr(m.header, "frame_id", ""), "frame_id"),
+        (lambda m: setattr(m.percepts[0], "colour", [0.5, 0.5]), "colour of 2 values"),
+        (lambda m: setattr(m.percepts[0], "colour", [math.nan] * COLOUR_BINS), "summing to 1"),
+        (lambda m: setattr(m.percepts[0], "colour", [0.5] * COLOUR_BINS), "summing to 1"),
     ],
 )
 def test_malformed_percepts_raise_invalid_input_with_the_reason(mutate, reason: str) -> None:

@@ -26,6 +26,7 @@ from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.perception.colour_histogram import COLOUR_BINS
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.ros.conversions.sensors import array_to_image, image_to_array, seconds_to_stamp, stamp_to_seconds
 from merlin2_sailor_interfaces.msg import Detection as DetectionMessage
@@ -168,6 +169,8 @@ def percept_to_message(percept: Percept) -> PerceptMessage:
     message.bbox.size.y = float(percept.box.height)
     if percept.crop.size > 0:
         message.crop = array_to_image(percept.crop, "rgb8", Header(stamp=message.stamp))
+    if percept.colour is not None:
+        message.colour = np.asarray(percept.colour, dtype=np.float32)
     return message
 
 
@@ -187,6 +190,7 @@ def percept_from_message(message: PerceptMessage, frame_id: str) -> Percept:
         if message.crop.encoding != "rgb8":
             raise InvalidInputError(f"percept crops must be rgb8, got '{message.crop.encoding}'")
         crop = image_to_array(message.crop)
+    colour = _colour_from_message(message)
     box = message.bbox
     return Percept(
         class_name=message.class_name,
@@ -199,7 +203,22 @@ def percept_from_message(message: PerceptMessage, frame_id: str) -> Percept:
         tracker_id=message.tracker_id,
         class_id=int(message.class_id),
         frame_id=frame_id,
+        colour=colour,
     )
+
+
+def _colour_from_message(message: PerceptMessage) -> np.ndarray | None:
+    """The percept's colour histogram, None when it has none; a malformed one is refused."""
+    colour = np.asarray(message.colour, dtype=np.float32)
+    if colour.size == 0:
+        return None
+    if colour.shape != (COLOUR_BINS,) or not np.all(np.isfinite(colour)) or np.any(colour < 0.0) \
+            or abs(float(colour.sum()) - 1.0) > 1e-3:
+        raise InvalidInputError(
+            f"percept '{message.class_name}' has a colour of {colour.size} values; it must be {COLOUR_BINS} "
+            "non-negative values summing to 1 (or none)"
+        )
+    return colour
 
 
 def percepts_to_message(percepts: Sequence[Percept], header: Header) -> PerceptArray:

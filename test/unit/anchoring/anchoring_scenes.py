@@ -17,6 +17,7 @@ from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.contract.pose import Pose
+from merlin2_sailor.perception.colour_histogram import COLOUR_BINS, HUE_BINS
 
 #: A small camera (160 x 120, ~77 degrees horizontal field of view) keeps depth images cheap.
 TEST_INTRINSICS = CameraIntrinsics(fx=100.0, fy=100.0, cx=79.5, cy=59.5, width=160, height=120)
@@ -36,6 +37,18 @@ class SceneObject:
     size: tuple[float, float, float] = (0.1, 0.1, 0.12)
     looks_like: str = ""
     """Another identity whose appearance this object shares (identical-looking objects)."""
+    colour: np.ndarray | None = field(default=None, compare=False)
+    """The colour histogram of the object's own pixels (see :func:`mug_colour`); percepts carry
+    it with a little noise; None: percepts have no colour."""
+
+
+def mug_colour(hue_bin: int, share: float = 0.15) -> np.ndarray:
+    """A histogram like the demo's mugs: most pixels shared by every mug of the make (coffee,
+    shadow: hue bins 0-1, dark grey), ``share`` of them in the mug's own hue bin."""
+    histogram = np.zeros(COLOUR_BINS)
+    histogram[[0, 1, HUE_BINS]] = np.array([0.35, 0.45, 0.2]) * (1.0 - share)
+    histogram[hue_bin] += share
+    return histogram / histogram.sum()
 
 
 @dataclass
@@ -46,6 +59,7 @@ class PerceptMaker:
     dimension: int = 32
     position_noise: float = 0.01
     appearance_noise: float = 0.05
+    colour_noise: float = 0.01
     _rng: np.random.Generator = field(init=False)
     _appearances: dict[str, np.ndarray] = field(init=False, default_factory=dict)
 
@@ -74,6 +88,10 @@ class PerceptMaker:
             clean = self.appearance(item.looks_like or item.identity)
             noise = self._rng.normal(scale=self.appearance_noise / math.sqrt(self.dimension), size=self.dimension)
             embedding = (clean + noise).astype(np.float32)
+        colour = None
+        if item.colour is not None:
+            colour = np.clip(item.colour + self._rng.normal(scale=self.colour_noise, size=COLOUR_BINS), 0.0, None)
+            colour = (colour / colour.sum()).astype(np.float32)
         return Percept(
             class_name=class_name or item.class_name,
             score=0.9,
@@ -84,6 +102,7 @@ class PerceptMaker:
             crop=np.zeros((0, 0, 3), dtype=np.uint8) if crop is None else crop,
             tracker_id=tracker_id,
             embedding=embedding,
+            colour=colour,
         )
 
 

@@ -12,10 +12,13 @@ from merlin2_sailor.perception.colour_histogram import (
     COLOUR_DESCRIPTOR_SIZE,
     GREY_BINS,
     HUE_BINS,
+    MINIMUM_OBJECT_PIXELS,
     colour_descriptor,
     colour_descriptors,
     colour_histogram,
     colour_similarity,
+    object_colour,
+    object_colour_similarity,
 )
 
 
@@ -100,3 +103,27 @@ def test_a_batch_is_one_descriptor_per_crop_and_bad_crops_are_refused():
             colour_descriptor(bad)
     with pytest.raises(InvalidInputError, match="colour histogram"):
         colour_histogram(np.zeros((0, 3), np.uint8))
+
+
+def test_an_object_colour_reads_only_the_marked_pixels_and_needs_enough_of_them():
+    crop = plain((220, 20, 20), (60, 60))
+    crop[10:40, 10:40] = (20, 200, 40)
+    pixels = np.zeros((60, 60), dtype=bool)
+    pixels[10:40, 10:40] = True
+    colour = object_colour(crop, pixels)
+    np.testing.assert_allclose(colour, colour_histogram(plain((20, 200, 40))), atol=1e-6)
+    assert object_colour_similarity(colour, colour_histogram(crop)) == pytest.approx(0.25, abs=0.01)
+    # A far object's few pixels are mostly its outline: too few to tell its colour.
+    few = np.zeros((60, 60), dtype=bool)
+    few[10:30, 10:30] = True
+    assert few.sum() < MINIMUM_OBJECT_PIXELS and object_colour(crop, few) is None
+    with pytest.raises(InvalidInputError, match="do not match"):
+        object_colour(crop, pixels[:20])
+
+
+def test_an_object_colour_of_many_pixels_is_an_even_subsample_of_them():
+    rng = np.random.default_rng(0)
+    crop = rng.integers(0, 256, size=(300, 400, 3), dtype=np.uint8)
+    everything = np.ones((300, 400), dtype=bool)
+    subsampled = object_colour(crop, everything)
+    np.testing.assert_allclose(subsampled, colour_histogram(crop), atol=0.02)

@@ -10,6 +10,7 @@ from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.box3d import RejectionReason
+from merlin2_sailor.perception.colour_histogram import colour_histogram, object_colour_similarity
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptGenerator, PerceptGeneratorConfig
 
@@ -141,3 +142,19 @@ def test_point_cloud_input_matches_depth_input(motorcycle_scene: RgbdScene) -> N
 def test_config_needs_a_world_frame() -> None:
     with pytest.raises(ConfigurationError):
         PerceptGeneratorConfig(world_frame="")
+
+
+def test_the_colour_is_read_from_the_objects_own_pixels_not_the_wall_its_box_also_covers() -> None:
+    """A green object 2 m away inside a box that also covers the red wall 4 m behind it: the box's
+    colour would be mostly red, the object's is green."""
+    inner = (230, 200, 270, 280)
+    depth, intrinsics = wall_with_box_scene(object_corners=inner)
+    image = np.zeros((480, 640, 3), dtype=np.uint8)
+    image[:] = (200, 30, 30)
+    image[200:280, 230:270] = (30, 200, 30)
+    batch = PerceptGenerator().generate([detection(OBJECT)], image, depth, intrinsics, Pose.identity(), 0.0)
+    (percept,) = batch.percepts
+    expected = colour_histogram(np.array([[[30, 200, 30]]], dtype=np.uint8))
+    np.testing.assert_allclose(percept.colour, expected, atol=1e-6)
+    # The crop as a whole is mostly the red wall: its colour shares little with the object's.
+    assert object_colour_similarity(percept.colour, colour_histogram(percept.crop)) < 0.25
