@@ -17,6 +17,7 @@ from merlin2_sailor.knowledge import (
     domain_text,
     problem_text,
 )
+from merlin2_sailor.knowledge.model import ROOT_TYPE
 
 DOMAIN_NAME = "merlin2"
 PROBLEM_NAME = "sailor_mission"
@@ -54,16 +55,25 @@ def task_from_store(
     mentioned = {goal.predicate for goal in goal_propositions} | {
         literal.predicate for action in actions for literal in (*action.conditions, *action.effects)
     }
+    # The anchoring node writes while a mission reads: a type before its objects, an object before
+    # its facts. Read in the reverse order (facts, objects, types), so that what one read names was
+    # written before the next read; and leave out what a concurrent removal left dangling, since
+    # the next plan reads again. (Read types first, a cup seen a moment later was an object of an
+    # undeclared type, and the planner's parser failed on it.)
     facts = [
         proposition
         for proposition in store.propositions.get_all()
         if not proposition.is_goal and proposition.predicate in mentioned
     ]
     predicates = [p for p in store.predicates.get_all() if p.name in mentioned]
+    objects = store.objects.get_all()
+    types = store.types.get_all()
+    declared = {pddl_type.name for pddl_type in types} | {ROOT_TYPE}
+    objects = [pddl_object for pddl_object in objects if pddl_object.type in declared]
+    known = {pddl_object.name for pddl_object in objects}
+    facts = [fact for fact in facts if known.issuperset(fact.objects)]
     return PlanningTask(
-        domain=domain_text(DOMAIN_NAME, store.types.get_all(), predicates, actions),
-        problem=problem_text(
-            PROBLEM_NAME, DOMAIN_NAME, store.objects.get_all(), facts + goal_propositions
-        ),
+        domain=domain_text(DOMAIN_NAME, types, predicates, actions),
+        problem=problem_text(PROBLEM_NAME, DOMAIN_NAME, objects, facts + goal_propositions),
         actions=tuple(sorted(action.name for action in actions)),
     )

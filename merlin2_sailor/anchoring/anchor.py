@@ -65,6 +65,13 @@ class Anchor:
     before any was available."""
     colour: ColourModel | None = None
     """The colours of its whole views' own pixels (:mod:`.colour_evidence`); None before any."""
+    colour_seen: float | None = None
+    """When a whole view with a colour was last fused (None: never): how long the anchor's colour
+    has gone unchecked, which is what an absence is measured from (colourless views of something
+    in its place say nothing about whether it is still the same object)."""
+    colour_disputed: bool = False
+    """A whole view of another colour stood where this anchor was expected: until a view of its own
+    colour is fused, views that show no colour cannot be it either."""
     visible: bool = False
     """Reacquired or acquired in the latest processed frame."""
     missed_frames: int = 0
@@ -113,6 +120,7 @@ class Anchor:
             whole_views=0 if partial else 1,
             gallery=None if embedding is None else add_to_gallery(None, embedding, config.gallery_size),
             colour=None if partial else with_view(None, percept.colour),
+            colour_seen=None if partial or percept.colour is None else percept.stamp,
             visible=True,
             perceived_position=position.copy(),
         )
@@ -137,6 +145,9 @@ class Anchor:
             self.whole_views += 1
             self.size = fuse_size(self.size, percept.size, self.whole_views, config)
             self.colour = with_view(self.colour, percept.colour)
+            if percept.colour is not None:
+                self.colour_seen = percept.stamp
+                self.colour_disputed = False
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
         if embedding is not None:

@@ -186,6 +186,8 @@ class Anchoring:
         # Without a camera nothing says which views are whole, so no single view is colour evidence.
         whole = None if camera is None else [not flag for flag in partial]
         table = self._table_builder.build(percepts, self._index, whole)
+        for anchor in table.disputed:
+            anchor.colour_disputed = True
         percepts = table.percepts
         assignment = assign(table.scores, self.config.match_threshold)
         symbols = [""] * len(percepts)

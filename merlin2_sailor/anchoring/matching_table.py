@@ -133,6 +133,8 @@ class MatchingTable:
     continuations: np.ndarray
     shortcut: np.ndarray
     embedded: int = 0
+    disputed: tuple[Anchor, ...] = ()
+    """Anchors a whole view of another colour was ruled out from (see :mod:`.colour_evidence`)."""
 
 
 class MatchingTableBuilder:
@@ -208,12 +210,14 @@ class MatchingTableBuilder:
             scores[searched] = np.minimum(scores[searched], self.config.search_score_cap)
         scores[shortcut] = np.where(eligible[shortcut], self.config.tracker_continuity_score, self.config.gated_score)
         scores = apply_tracker_continuity(scores, continuations, same_class, self.config.tracker_continuity_score)
+        disputed: tuple[Anchor, ...] = ()
         if whole is not None:
-            ruled_out = self._ruled_out_by_colour(percepts, anchors, anchor_columns.last_seen, whole, ~gated)
+            ruled_out, differing = self._ruled_out_by_colour(percepts, anchors, whole, ~gated)
             scores[ruled_out] = self.config.gated_score
             gated |= ruled_out
             continuations &= ~ruled_out
-        return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded)
+            disputed = tuple(anchors[column] for column in np.flatnonzero(differing.any(axis=0)))
+        return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded, disputed)
 
     def _ungated_pairs(self, percepts: PerceptColumns, index: AnchorIndex) -> tuple[np.ndarray, np.ndarray]:
         """(rows, slots) of the pairs that pass the gate, computed on the index's arrays only.
@@ -241,19 +245,27 @@ class MatchingTableBuilder:
         return rows[passing], slots[passing]
 
     def _ruled_out_by_colour(
-        self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], last_seen: np.ndarray,
-        whole: Sequence[bool], open_pairs: np.ndarray,
-    ) -> np.ndarray:
-        """(P, A) pairs whose percept, a whole view, is of another colour than its anchor, unseen
-        for the configured absence."""
+        self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: Sequence[bool], open_pairs: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(ruled out, differing), both (P, A): the pairs gated by colour, and among them those
+        whose percept, a whole view with a colour, differed from an anchor whose colour had gone
+        unchecked for the configured absence; the others are views without a colour (far, cut off)
+        of what stands where a disputed anchor was."""
         ruled_out = np.zeros(open_pairs.shape, dtype=bool)
+        differing = np.zeros(open_pairs.shape, dtype=bool)
         if self.colour.minimum_views == 0:
-            return ruled_out
+            return ruled_out, differing
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
-            percept = percepts[row]
-            if whole[row] and percept.stamp - last_seen[column] >= self.colour.absence:
-                ruled_out[row, column] = view_differs(anchors[column].colour, percept.colour, self.colour)
-        return ruled_out
+            percept, anchor = percepts[row], anchors[column]
+            if whole[row] and percept.colour is not None:
+                checked = anchor.colour_seen if anchor.colour_seen is not None else anchor.last_seen
+                if percept.stamp - checked >= self.colour.absence or anchor.colour_disputed:
+                    differing[row, column] = view_differs(anchor.colour, percept.colour, self.colour)
+                ruled_out[row, column] = differing[row, column]
+            else:
+                # Nothing coloured has been its colour there since: a colourless view is no way back.
+                ruled_out[row, column] = anchor.colour_disputed and anchor.state is AnchorState.MISSING
+        return ruled_out, differing
 
     def _embed_needed(self, percepts: tuple[Percept, ...], rows: np.ndarray) -> tuple[tuple[Percept, ...], int]:
         """Embed, in one call, the crops of the given percepts that have none yet."""

@@ -333,9 +333,9 @@ SETTINGS: tuple[Setting, ...] = (
                 "How many standard deviations of the two anchors' own views that difference must also "
                 "exceed (views of one object vary with light and angle).", 0.0, 100.0),
         Setting("colour_absence", ("core", "colour", "absence"),
-                "Seconds an anchor must have gone unseen before one whole view of another colour rules "
-                "out that it is the anchor's object (a look-alike put in its place while the camera looked "
-                "away); 0: always.", 0.0, 1e6),
+                "Seconds an anchor's colour must have gone unchecked (no whole view with a colour) before "
+                "one whole view of another colour rules out that it is the anchor's object (a look-alike "
+                "put in its place while the camera looked away); 0: always.", 0.0, 1e6),
     ),
     *_group(
         "Spatial index (performance only)",

@@ -54,6 +54,8 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "colour": None if anchor.colour is None else {
             "views": int(anchor.colour.views), "mean": anchor.colour.mean.tolist(),
             "squares": anchor.colour.squares.tolist()},
+        "colour_seen": anchor.colour_seen,
+        "colour_disputed": bool(anchor.colour_disputed),
         "missed_frames": int(anchor.missed_frames),
         "recovery_sightings": int(anchor.recovery_sightings),
         "missing_since": anchor.missing_since,
@@ -84,6 +86,8 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             position_variance=float(data["position_variance"]),
             gallery=_gallery(data.get("gallery")),
             colour=_colour(data.get("colour")),
+            colour_seen=None if data.get("colour_seen") is None else float(data["colour_seen"]),
+            colour_disputed=bool(data.get("colour_disputed", False)),
             visible=False,
             missed_frames=int(data.get("missed_frames", 0)),
             recovery_sightings=int(data.get("recovery_sightings", 0)),

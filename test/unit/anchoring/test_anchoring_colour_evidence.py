@@ -255,3 +255,22 @@ def test_the_colour_model_survives_a_snapshot_through_json() -> None:
     snapshot["anchors"][0]["colour"]["mean"] = [0.1, 0.2]
     with pytest.raises(InvalidInputError, match="colour"):
         rules().restore(snapshot)
+
+
+def test_views_without_colour_do_not_bring_back_an_anchor_a_view_of_another_colour_disputed() -> None:
+    """The swap seen from afar first: far views carry no colour, so they reacquire the red mug's
+    anchor; the first close view shows green; from then on the red anchor, missing, can be brought
+    back only by a view of its own colour, not by more colourless ones."""
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
+    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
+    green_far = SceneObject("green", "cup", KITCHEN)
+    anchoring, maker = rules(), PerceptMaker(seed=6)
+    see(anchoring, maker, [red], 0.0)
+    assert see(anchoring, maker, [green_far], 60.0, frames=2).percept_symbols == ("cup_1",)
+    assert see(anchoring, maker, [green], 61.0).percept_symbols == ("cup_2",)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING and anchoring.get("cup_1").colour_disputed
+    assert see(anchoring, maker, [green_far], 62.0, frames=6).percept_symbols == ("cup_2",)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    # The red mug put back: a view of its own colour settles the dispute.
+    assert see(anchoring, maker, [red], 120.0, frames=6).percept_symbols == ("cup_1",)
+    assert not anchoring.get("cup_1").colour_disputed

@@ -17,6 +17,7 @@ from merlin2_sailor.knowledge import (
     Provenance,
     open_store,
 )
+from merlin2_sailor.knowledge.model import ROOT_TYPE
 from merlin2_sailor_behaviors.planning import (
     EffectWriter,
     Planner,
@@ -103,3 +104,65 @@ def test_a_missing_engine_is_a_dependency_error_naming_the_package() -> None:
     planner = Planner(PlannerConfig(engine="no_such_engine"))
     with pytest.raises(DependencyError, match="pip install its up-"):
         planner.plan(task_from_store(open_store("memory"), [Proposition("x")]))
+
+
+class _WrittenWhileRead:
+    """A store that the anchoring node writes to while the task is read: before each table read,
+    the writer takes its next step."""
+
+    def __init__(self, store, steps) -> None:
+        self._store, self._steps = store, list(steps)
+
+    def __getattr__(self, name):
+        table = getattr(self._store, name)
+        outer = self
+
+        class Table:
+            def get_all(self):
+                if outer._steps:
+                    outer._steps.pop(0)()
+                return table.get_all()
+
+            def __getattr__(self, attribute):
+                return getattr(table, attribute)
+
+        return Table()
+
+
+def _anchor_cup(store) -> None:
+    store.types.save(PddlType("cup"))
+    store.objects.save(PddlObject("cup_1", "cup"))
+    store.propositions.save(Proposition("object_at", ("cup_1", "a")))
+
+
+def _forget_cup(store) -> None:
+    store.propositions.delete(Proposition("object_at", ("cup_1", "a")))
+    store.objects.delete(PddlObject("cup_1", "cup"))
+
+
+@pytest.mark.parametrize("change", ["anchor", "forget"])
+@pytest.mark.parametrize("before_read", range(6))
+def test_a_task_read_while_the_anchoring_node_writes_is_consistent_and_parses(change: str, before_read: int) -> None:
+    """A cup anchored while a mission reads the knowledge base: its type, object and fact land
+    between the task's reads. Whatever the timing, every object's type is declared and every fact
+    names declared objects (the demo crashed on "KeyError: 'cup'" when types were read first)."""
+    from unified_planning.io import PDDLReader
+
+    with open_store("memory") as store:
+        store.types.save(PddlType("wp"))
+        store.objects.save(PddlObject("a", "wp"))
+        store.predicates.save(Predicate("robot_at", ("wp",)))
+        store.predicates.save(Predicate("object_at", (ROOT_TYPE, "wp")))
+        store.actions.save(NAVIGATION)
+        store.actions.save(PddlAction("look", (Parameter("o", ROOT_TYPE), Parameter("w", "wp")),
+                                      (Condition("object_at", ("o", "w"), "at start"),), ()))
+        if change == "forget":
+            _anchor_cup(store)
+        write = _anchor_cup if change == "anchor" else _forget_cup
+        writes = [lambda: None] * before_read + [lambda: write(store)]
+        task = task_from_store(_WrittenWhileRead(store, writes), [Proposition("robot_at", ("a",))])
+    problem = PDDLReader().parse_problem_string(task.domain, task.problem)
+    names = {item.name for item in problem.all_objects}
+    assert "a" in names
+    if "(object_at cup_1 a)" in task.problem:
+        assert "cup_1" in names
