@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -302,3 +303,13 @@ def test_malformed_clouds_raise_invalid_input_with_the_reason(mutate, reason: st
     mutate(message)
     with pytest.raises(InvalidInputError, match=reason):
         point_cloud_to_array(message)
+
+
+def test_a_mask_vertex_far_outside_the_image_rasterises_like_one_at_its_edge() -> None:
+    far = Mask(height=10, width=10, data=[Point2D(x=2.0, y=2.0), Point2D(x=1e15, y=2.0), Point2D(x=2.0, y=7.0)])
+    near = Mask(height=10, width=10, data=[Point2D(x=2.0, y=2.0), Point2D(x=9.0, y=2.0), Point2D(x=2.0, y=7.0)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no invalid cast to int32
+        raster = mask_from_message(far)
+    assert raster[2, 2:].all() and raster[6, 2] and not raster[8].any()
+    assert raster.sum() > mask_from_message(near).sum()

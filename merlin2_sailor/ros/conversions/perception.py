@@ -148,6 +148,11 @@ def mask_from_message(message: Mask) -> np.ndarray | None:
     import cv2
 
     raster = np.zeros((message.height, message.width), dtype=np.uint8)
+    # Vertices far outside the image are clipped to a margin around it first: they rasterise the
+    # same inside it, and a coordinate beyond int32 would otherwise wrap to nonsense in the cast.
+    margin = float(max(message.height, message.width))
+    vertices[:, 0] = np.clip(vertices[:, 0], -margin, message.width + margin)
+    vertices[:, 1] = np.clip(vertices[:, 1], -margin, message.height + margin)
     cv2.fillPoly(raster, [np.round(vertices).astype(np.int32)], 1)
     return raster.astype(bool)
 
