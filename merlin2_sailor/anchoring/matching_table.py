@@ -253,8 +253,8 @@ class MatchingTableBuilder:
         of what stands where a disputed anchor was."""
         ruled_out = np.zeros(open_pairs.shape, dtype=bool)
         differing = np.zeros(open_pairs.shape, dtype=bool)
-        if self.colour.minimum_views == 0:
-            return ruled_out, differing
+        if self.colour.minimum_views == 0 or not any(a.colour is not None or a.colour_disputed for a in anchors):
+            return ruled_out, differing  # no anchor has a colour to tell by: spare the loop over pairs
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
             if whole[row] and percept.colour is not None:

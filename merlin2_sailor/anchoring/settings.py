@@ -324,8 +324,9 @@ SETTINGS: tuple[Setting, ...] = (
                 "closer than this cannot tell two look-alikes apart: nothing is merged, and it is said).",
                 0.0, 0.99),
         Setting("colour_minimum_views", ("core", "colour", "minimum_views"),
-                "Whole views each of two anchors needs before their colours (of the object's own pixels) "
-                "may rule out that they are one object (0 turns colour evidence off).", 0, 1000),
+                "Whole views an anchor needs before its colour (of the object's own pixels) is known; one of "
+                "two anchors compared must know it before colours may rule out that they are one object "
+                "(0 turns colour evidence off).", 0, 1000),
         Setting("colour_minimum_difference", ("core", "colour", "minimum_difference"),
                 "Share of an object's pixels by which one 60-degree hue window (or a grey level) of two "
                 "anchors must differ to rule out a merge (a red mug's red is about 0.12-0.2).", 0.001, 0.999),

@@ -54,7 +54,7 @@ class Percept:
     embedding. ``embedding`` is filled only when a crop was already embedded upstream.
     ``colour`` is the colour histogram of the object's own pixels (those its 3D box was measured
     on, not the background its 2D box also covers; see
-    :func:`~merlin2_sailor.perception.colour_histogram.colour_histogram`), or None when unknown:
+    :func:`~merlin2_sailor.perception.colour_histogram.object_colour`), or None when unknown:
     the appearance evidence every matcher can afford, since it needs no network.
     """
 
