@@ -56,8 +56,9 @@ class ColourEvidenceConfig:
     """``minimum_views``: whole views an anchor needs before its colour is known (one of the two
     compared must know it; 0 turns the evidence off); ``minimum_difference``: the share of the
     object's pixels by which one colour window must differ (0..1); ``noise_factor``: how many
-    standard deviations of the two anchors' own views the difference must also exceed; ``absence`` (s): how long an anchor's colour must
-    have gone unchecked before one view of another colour rules it out."""
+    standard deviations of the two anchors' own views the difference must also exceed;
+    ``absence`` (s): how long an anchor's colour must have gone unchecked before one view of
+    another colour rules it out."""
 
     minimum_views: int = 3
     minimum_difference: float = 0.1
