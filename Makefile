@@ -30,8 +30,11 @@ pipeline-demo: setup
 		echo && echo "What the robot knows now (sailor knowledge show --store sqlite://$(PIPELINE_DATA)/knowledge.db):" && \
 		$(VENV)/bin/sailor knowledge show --store sqlite://$(CURDIR)/$(PIPELINE_DATA)/knowledge.db
 
+# With SAILOR_UPSTREAM=path/to/sources (the layout of ../shared/upstream: KANT, YASMIN, MERLIN2...),
+# the tests against the real MERLIN2 stack run too; scripts/upstream_env.sh builds it once.
 test: setup
-	@SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest
+	@upstream_env="$$(scripts/upstream_env.sh)" && . "$$upstream_env" && \
+		SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

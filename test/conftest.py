@@ -14,6 +14,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import uuid
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,6 +37,70 @@ os.environ.setdefault("SAILOR_MODEL_CACHE", str(cache_folder()))
 # Nodes keep state under ~ (e.g. ~/.sailor/anchoring): tests must neither read a user's state
 # nor leave theirs behind, so this run gets a home of its own.
 os.environ["HOME"] = tempfile.mkdtemp(prefix="sailor-test-home-")
+
+# With SAILOR_UPSTREAM, scripts/upstream_env.sh puts the real YASMIN on the path; the behaviours
+# keep running on the project's own implementation of its API unless a run asks for the real one.
+os.environ.setdefault("SAILOR_STATE_MACHINES", "local")
+
+UPSTREAM_VARIABLE = "SAILOR_UPSTREAM"
+
+
+def require_upstream(*modules: str) -> None:
+    """Skip, saying why, when the real MERLIN2 stack is not set up; fail when it is set up but broken.
+
+    ``make test`` sources scripts/upstream_env.sh, which builds the stack from the source checkouts
+    that ``SAILOR_UPSTREAM`` names (``.ci/run`` sets it to ../shared/upstream where that exists).
+    """
+    import importlib
+
+    if not os.environ.get(UPSTREAM_VARIABLE):
+        pytest.skip(f"{UPSTREAM_VARIABLE} is unset: the tests against the real MERLIN2 stack need it "
+                    f"(run: {UPSTREAM_VARIABLE}=../shared/upstream make test)")
+    for module in modules:
+        try:
+            importlib.import_module(module)
+        except ImportError as error:
+            pytest.fail(f"{UPSTREAM_VARIABLE}={os.environ[UPSTREAM_VARIABLE]} is set but {module} does not import "
+                        f"({error}); run the tests through `make test`, which sources scripts/upstream_env.sh")
+
+
+@pytest.fixture
+def upstream_stack() -> Callable[..., None]:
+    """:func:`require_upstream`, for tests that need the real MERLIN2 stack."""
+    return require_upstream
+
+
+KANT_NODE_MODULE = "kant_knowledge_base.knowledge_base_node_main"
+"""KANT's knowledge-base node, MERLIN2's knowledge base, as ``ros2 run kant_knowledge_base`` starts it."""
+
+
+@dataclass
+class KantNode:
+    """KANT's knowledge-base node running as a process, and where a ``kant+ros`` store finds it."""
+
+    location: str
+    process: subprocess.Popen
+
+
+@pytest.fixture
+def kant_node(upstream_stack) -> Iterator[KantNode]:
+    """KANT's own knowledge-base node, unmodified, as a process in a namespace of this test's own."""
+    upstream_stack("kant_knowledge_base", "kant_msgs.srv", "simple_node")
+    namespace = f"/kant_{uuid.uuid4().hex[:12]}"
+    process = subprocess.Popen(
+        [sys.executable, "-m", KANT_NODE_MODULE, "--ros-args", "-r", f"__ns:={namespace}"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+    )
+    try:
+        yield KantNode(f"kant+ros://{namespace}", process)
+    finally:
+        process.send_signal(signal.SIGINT)  # what ros2 launch sends; KANT's node ignores SIGTERM
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
 
 # --- Fixtures for tests that talk to real nodes over DDS -----------------------------------
 # ros_probe gives a node spinning in a background thread of its own context and guarantees the

@@ -351,7 +351,8 @@ SETTINGS: tuple[Setting, ...] = (
         "Persistence: the knowledge base and the state on disk, off the perception hot path",
         Setting("knowledge_base", ("persistence", "knowledge_base"),
                 "Knowledge base the anchors are synced into, by diff: ros:///merlin2 (the knowledge_base "
-                "node), sqlite:///path, mongodb://host/db, memory, or \"\" for none.", deployment=True),
+                "node), kant+ros:///merlin2 (KANT's node, MERLIN2's knowledge base), sqlite:///path, "
+                "mongodb://host/db, memory, or \"\" for none.", deployment=True),
         Setting("grounding", ("persistence", "grounding"),
                 "Grounding relation (class -> type, waypoints, predicates); \"\" uses config/grounding.yaml.",
                 deployment=True),

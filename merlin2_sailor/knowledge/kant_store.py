@@ -29,6 +29,7 @@ from typing import Any
 from merlin2_sailor.errors import ConfigurationError, DependencyError, KnowledgeError
 from merlin2_sailor.knowledge import model
 from merlin2_sailor.knowledge.changes import ChangeEvent, ItemKind, Operation
+from merlin2_sailor.knowledge.kant_projection import KantKinds, KantProjection, item_key, kant_duration
 from merlin2_sailor.knowledge.mirrored_store import MirroredStore
 from merlin2_sailor.knowledge.model import KnowledgeItem, Proposition
 from merlin2_sailor.knowledge.rules import KnowledgeState
@@ -36,6 +37,8 @@ from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS
 
 #: ``kant+mongodb://host:port/database``: KANT's MongoDB family; what follows ``kant+`` is KANT's URI.
 MONGODB_SCHEME = "kant+mongodb://"
+_KINDS_IN_ORDER = (ItemKind.TYPE, ItemKind.PREDICATE, ItemKind.OBJECT, ItemKind.PROPOSITION, ItemKind.ACTION)
+"""Dependencies first: what KANT must hold before a fact or an action can refer to it."""
 KANT_MISSING = (
     "the KANT store needs MERLIN2's kant_dto and kant_dao packages; build KANT in your "
     "ROS 2 workspace (https://github.com/uleroboticsgroup/kant) and source it"
@@ -70,7 +73,7 @@ class KantStore(MirroredStore):
             ItemKind.PROPOSITION: dao_factory.create_pddl_proposition_dao(),
             ItemKind.ACTION: dao_factory.create_pddl_action_dao(),
         }
-        self._provenances: dict[Hashable, model.Provenance] = {}
+        self._projection = KantProjection()
         # Items of the batch being written, for DTOs of things the same batch deleted.
         self._batch_items: dict[tuple[ItemKind, Hashable], KnowledgeItem] = {}
         self._open_mirror()
@@ -112,29 +115,70 @@ class KantStore(MirroredStore):
     # What MirroredStore needs.
 
     def _reload(self) -> None:
+        self._require_open()
         self._state = KnowledgeState()
         self._state.load(self._load())
 
     def _load(self) -> list[KnowledgeItem]:
         items: list[KnowledgeItem] = []
-        for kind in (ItemKind.TYPE, ItemKind.OBJECT, ItemKind.PREDICATE, ItemKind.PROPOSITION, ItemKind.ACTION):
-            items.extend(self._from_dto(kind, dto) for dto in self._daos[kind].get_all() or [])
+        for kind in _KINDS_IN_ORDER:
+            for dto in self._daos[kind].get_all() or []:
+                if kind is ItemKind.TYPE and dto.get_name() == model.ROOT_TYPE:
+                    continue  # MERLIN2's plain type 'object' is SAILOR's root, never declared
+                items.append(self._projection.restore(kind, self._from_dto(kind, dto)))
         return items
 
     def _persist(self, events: Sequence[ChangeEvent]) -> None:
+        before = self._projection.kinds
+        self._projection.update(item for kind in _KINDS_IN_ORDER for item in self._state.get_all(kind))
         self._batch_items = {(event.kind, getattr(event.item, "name", None)): event.item for event in events}
-        for event in events:
-            dao = self._daos[event.kind]
-            dto = self._to_dto(event.item)
-            written = dao.save(dto) if event.operation is Operation.SAVE else dao.delete(dto)
-            if written is False:
-                verb = "save" if event.operation is Operation.SAVE else "delete"
-                raise KnowledgeError(f"KANT refused to {verb} {event.kind.value} {event.item}")
-            if isinstance(event.item, Proposition):
-                if event.operation is Operation.SAVE:
-                    self._provenances[event.item.key] = event.item.provenance
-                else:
-                    self._provenances.pop(event.item.key, None)
+        deletions = [event for event in events if event.operation is Operation.DELETE]
+        saves = [event for event in events if event.operation is Operation.SAVE]
+        saves += self._retyped(before, {item_key(event.kind, event.item) for event in events})
+        saves.sort(key=lambda event: _KINDS_IN_ORDER.index(event.kind))
+        for event in (*deletions, *saves):
+            self._write(event)
+
+    def _retyped(self, before: KantKinds, batch_keys: set) -> list[ChangeEvent]:
+        """Saves of items this batch left alone whose KANT types it changed (two kinds met)."""
+        changed = set(before.mapping.items()) ^ set(self._projection.kinds.mapping.items())
+        if not changed:
+            return []
+        retyped = []
+        for kind in (ItemKind.PREDICATE, ItemKind.OBJECT, ItemKind.ACTION):
+            for item in self._state.get_all(kind):
+                if item_key(kind, item) not in batch_keys and self._projected_differently(item, before):
+                    retyped.append(ChangeEvent(Operation.SAVE, kind, item))
+        return retyped
+
+    def _projected_differently(self, item: KnowledgeItem, before: KantKinds) -> bool:
+        now = self._projection.kinds
+        if isinstance(item, model.PddlObject):
+            return before(item.type) != now(item.type)
+        if isinstance(item, model.Predicate):
+            return any(before(t) != now(t) for t in item.parameter_types)
+        return any(before(p.type) != now(p.type) for p in item.parameters)  # type: ignore[union-attr]
+
+    def _write(self, event: ChangeEvent) -> None:
+        projected = self._projection.project(event.item)
+        if projected is None:
+            return
+        dao = self._daos[event.kind]
+        dto = self._to_dto(projected)
+        if event.operation is Operation.SAVE:
+            if dao.save(dto) is False:
+                raise KnowledgeError(f"KANT refused to save {event.kind.value} {projected}")
+            self._projection.remember(event.kind, event.item)
+        else:
+            if dao.delete(dto) is False and self._still_in_kant(event.kind, projected):
+                raise KnowledgeError(f"KANT refused to delete {event.kind.value} {projected}")
+            self._projection.forget(event.kind, event.item)
+
+    def _still_in_kant(self, kind: ItemKind, item: KnowledgeItem) -> bool:
+        """Whether KANT still holds an item it would not delete (KANT cascades some deletions)."""
+        if kind is ItemKind.PROPOSITION:
+            return any(self._from_dto(kind, dto) == item for dto in self._daos[kind].get_all() or [])
+        return self._daos[kind].get(item.name) is not None  # type: ignore[union-attr]
 
     def _close_database(self) -> None:
         """KANT's DAOs hold no resources of ours."""
@@ -145,7 +189,9 @@ class KantStore(MirroredStore):
         return self._dto.PddlTypeDto(name)
 
     def _stored(self, kind: ItemKind, name: str) -> Any:
-        return self._state.get(kind, name) or self._batch_items.get((kind, name))
+        """The item as KANT holds it, from this batch's state."""
+        item = self._state.get(kind, name) or self._batch_items.get((kind, name))
+        return None if item is None else self._projection.project(item)
 
     def _object_dto(self, name: str) -> Any:
         stored = self._stored(ItemKind.OBJECT, name)
@@ -185,7 +231,7 @@ class KantStore(MirroredStore):
             action.name, list(parameters.values()), [literal(c) for c in action.conditions],
             [literal(e) for e in action.effects], action.durative,
         )
-        dto.set_duration(action.duration)
+        dto.set_duration(kant_duration(action.duration))
         return dto
 
     def _from_dto(self, kind: ItemKind, dto: Any) -> KnowledgeItem:
@@ -196,12 +242,10 @@ class KantStore(MirroredStore):
         if kind is ItemKind.PREDICATE:
             return model.Predicate(dto.get_name(), tuple(t.get_name() for t in dto.get_types()))
         if kind is ItemKind.PROPOSITION:
-            proposition = model.Proposition(
+            return model.Proposition(
                 dto.get_predicate().get_name(), tuple(o.get_name() for o in dto.get_objects()),
                 dto.get_is_goal(),
             )
-            provenance = self._provenances.get(proposition.key, model.Provenance.DECLARED)
-            return model.Proposition(proposition.predicate, proposition.objects, proposition.is_goal, provenance)
 
         def literal(item: Any, literal_class: type[model.TimedLiteral]) -> model.TimedLiteral:
             return literal_class(item.get_predicate().get_name(), tuple(o.get_name() for o in item.get_objects()),

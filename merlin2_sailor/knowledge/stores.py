@@ -34,7 +34,8 @@ STORES = PluginTable(
 LOCATION_FORMS = (
     "memory, sqlite:///absolute/path.db, sqlite://relative/path.db, mongodb://host:port/database, "
     "kant+mongodb://host:port/database; from ROS nodes and `sailor` commands also ros:///namespace "
-    "(the knowledge_base node, merlin2_sailor.ros.stores)"
+    "(the knowledge_base node) and kant+ros:///namespace (KANT's node, MERLIN2's knowledge base), "
+    "see merlin2_sailor.ros.stores"
 )
 
 

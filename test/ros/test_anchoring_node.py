@@ -64,10 +64,10 @@ class PerceptionStandIn:
         time.sleep(0.1)
 
 
-def start_anchoring(node_process, state_folder, knowledge_namespace):
+def start_anchoring(node_process, state_folder, knowledge_namespace, scheme="ros"):
     return node_process(
         "anchoring", "--ros-args", "-p", f"state_folder:={state_folder}",
-        "-p", f"knowledge_base:=ros://{knowledge_namespace}", "-p", "sync_period:=0.2",
+        "-p", f"knowledge_base:={scheme}://{knowledge_namespace}", "-p", "sync_period:=0.2",
         "-p", "save_period:=0.2")
 
 
@@ -176,3 +176,32 @@ def test_the_network_matcher_starts_with_the_shipped_weights_and_anchors(tmp_pat
     assert anchored, anchoring.text
     assert exit_code == 0, anchoring.text
     assert "with the network matcher" in anchoring.text
+
+
+def test_anchors_go_into_kant_as_in_a_merlin2_deployment(tmp_path, ros_probe, node_process, kant_node) -> None:
+    """launch/merlin2.yaml's arrangement: KANT's own node is the knowledge base; SAILOR's is not started."""
+    namespace = kant_node.location.removeprefix("kant+ros://")
+    anchoring = start_anchoring(node_process, tmp_path / "state", namespace, scheme="kant+ros")
+    assert ros_probe.wait_for_node("/anchoring"), anchoring.text
+    camera = PerceptionStandIn(ros_probe)
+    time.sleep(1.0)  # discovery between the stand-in's publishers and the node
+    for _ in range(4):
+        camera.frame([CUP, BOOK])
+    assert sorted(latest_anchors(ros_probe)) == ["book_1", "cup_1"], anchoring.text
+    for _ in range(4):  # the book is in view but no longer seen: missing, and so in KANT
+        camera.frame([CUP])
+
+    def kant_facts() -> set:
+        with open_store(kant_node.location) as kant:  # a reader that wrote nothing: KANT as it is
+            return {(fact.predicate, fact.objects) for fact in kant.propositions.get_all()}
+
+    assert ros_probe.wait_for(lambda: ("missing", ("book_1",)) in kant_facts(), timeout=15.0), anchoring.text
+    facts = kant_facts()
+    assert ("object_at", ("cup_1", "kitchen")) in facts and ("seen", ("cup_1",)) in facts
+    assert ("object_at", ("book_1", "kitchen")) not in facts
+    with open_store(kant_node.location) as kant:
+        # In KANT, anchors are MERLIN2's 'object' (KANT has no subtypes); waypoints stay 'wp'.
+        assert kant.objects.get("cup_1").type == "object"
+        assert kant.objects.get("kitchen").type == "wp"
+    assert anchoring.stop() == 0, anchoring.text
+    assert kant_node.process.poll() is None, "KANT's node died"

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 
 from merlin2_sailor.errors import DependencyError, KnowledgeError
@@ -100,6 +102,7 @@ def test_a_refusal_from_kant_is_a_knowledge_error(store, kant) -> None:
         store.objects.save(PddlObject("cup_2", "cup"))
 
 
-def test_without_kant_installed_the_error_says_how_to_get_it() -> None:
+def test_without_kant_installed_the_error_says_how_to_get_it(monkeypatch) -> None:
+    monkeypatch.setitem(sys.modules, "kant_dto", None)  # as if not installed, even under SAILOR_UPSTREAM
     with pytest.raises(DependencyError, match="build KANT"):
         import_kant_dto()

@@ -82,9 +82,10 @@ class TestOpenStore:
         with pytest.raises(ConfigurationError, match=r"merlin2_sailor\.ros\.stores"):
             open_store("ros:///merlin2")
 
-    def test_the_ros_layer_adds_ros_and_opens_the_core_stores_alike(self, tmp_path):
-        assert set(ros_stores.STORES.names) == {*STORES.names, "ros"}
+    def test_the_ros_layer_adds_its_two_nodes_and_opens_the_core_stores_alike(self, tmp_path):
+        assert set(ros_stores.STORES.names) == {*STORES.names, "ros", "kant+ros"}
         assert ros_stores.STORES.entries["ros"].endswith(":RemoteKnowledgeBase")
+        assert ros_stores.STORES.entries["kant+ros"].endswith(":KantRosStore")
         with ros_stores.open_store(f"sqlite://{tmp_path / 'kb.db'}") as store:
             assert isinstance(store, SqliteStore)
 
