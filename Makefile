@@ -31,10 +31,15 @@ pipeline-demo: setup
 		$(VENV)/bin/sailor knowledge show --store sqlite://$(CURDIR)/$(PIPELINE_DATA)/knowledge.db
 
 # With SAILOR_UPSTREAM=path/to/sources (the layout of ../shared/upstream: KANT, YASMIN, MERLIN2...),
-# the tests against the real MERLIN2 stack run too; scripts/upstream_env.sh builds it once.
+# the tests against the real MERLIN2 stack run too (scripts/upstream_env.sh builds it once), and the
+# behaviour suite runs a second time, on the real YASMIN instead of the project's own subset.
 test: setup
 	@upstream_env="$$(scripts/upstream_env.sh)" && . "$$upstream_env" && \
-		SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest
+		SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest && \
+		if [ -n "$${SAILOR_UPSTREAM:-}" ]; then \
+			echo "The behaviour suite again, on the real YASMIN from $$SAILOR_UPSTREAM:"; \
+			SAILOR_STATE_MACHINES=real $(VENV)/bin/python -m pytest test/unit/behaviors; \
+		fi
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

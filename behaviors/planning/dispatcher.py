@@ -236,6 +236,12 @@ class Dispatcher:
             outcome = behaviour(blackboard)
         except Exception as error:  # a bug in a behaviour: replanning would only repeat it
             self._write(lambda: self._effects.undo(applied))
+            if self._cancel_requested.is_set():
+                # Real YASMIN raises when a cancel meets a machine that does not end in
+                # ``canceled`` (a state's outcome with no transition, or a cancel between states):
+                # the mission was still cancelled, not failed.
+                _logger.info("%s raised %r while being cancelled", step.step, error)
+                return _Run(_Ending.CANCELED, f"cancelled during {step.step}")
             return _Run(_Ending.FAILED, f"behaviour of {step.step} raised {error!r}")
         finally:
             with self._lock:

@@ -37,10 +37,10 @@ def robot() -> FakeRobot:
     return robot
 
 
-def find(robot: FakeRobot, *objects: str) -> tuple[str, dict]:
+def find(robot: FakeRobot, *objects: str) -> tuple[str, Blackboard]:
     blackboard = FIND_OBJECT_ACTION.blackboard_for(objects)
     outcome = FIND_OBJECT_ACTION.make_state_machine(robot.context)(blackboard)
-    return outcome, dict(blackboard)
+    return outcome, blackboard
 
 
 def stops(robot: FakeRobot) -> list[str]:
@@ -57,7 +57,7 @@ def stops(robot: FakeRobot) -> list[str]:
 def test_find_goes_first_to_where_it_was_last_anchored_and_succeeds_there(robot: FakeRobot) -> None:
     robot.world["cup_1"] = (2.2, 0.1)
     outcome, blackboard = find(robot, "cup_1", "a")
-    assert outcome == SUCCEED, blackboard.get(REASON_KEY)
+    assert outcome == SUCCEED, blackboard
     assert stops(robot) == ["b"]
     assert robot.navigation.goals[0].yaw == pytest.approx(math.atan2(0.1, 0.2))  # facing its last place
     at = robot.anchoring.expectations[0]
@@ -70,7 +70,7 @@ def test_find_goes_first_to_where_it_was_last_anchored_and_succeeds_there(robot:
 def test_find_searches_the_other_waypoints_nearest_first_expecting_it_at_each(robot: FakeRobot) -> None:
     robot.world["cup_1"] = (5.1, 0.0)  # really at c, the last stop of the tour
     outcome, blackboard = find(robot, "cup_1", "a")
-    assert outcome == SUCCEED, blackboard.get(REASON_KEY)
+    assert outcome == SUCCEED, blackboard
     # From b, the nearest is a (2 m), then d (from a: 3.6 m; c: 5 m), then c (from d: 4.2 m).
     assert stops(robot) == ["b", "a", "d", "c"]
     announced = [(e.kind, e.place, e.position, e.radius) for e in robot.anchoring.expectations]
@@ -157,17 +157,17 @@ def scene() -> FakeRobot:
     return robot
 
 
-def bring(robot: FakeRobot, *objects: str) -> tuple[str, dict]:
+def bring(robot: FakeRobot, *objects: str) -> tuple[str, Blackboard]:
     blackboard = BRING_ACTION.blackboard_for(objects)
     outcome = BRING_ACTION.make_state_machine(robot.context)(blackboard)
-    return outcome, dict(blackboard)
+    return outcome, blackboard
 
 
 def test_bring_picks_expects_carried_carries_places_and_expects_it_there(scene: FakeRobot) -> None:
     scene.navigation.on_arrival.append(
         lambda pose: scene.anchoring.see("cup_1") if scene.grasp.places else None)  # seen once put down
     outcome, blackboard = bring(scene, "cup_1", "b", "c")
-    assert outcome == SUCCEED, blackboard.get(REASON_KEY)
+    assert outcome == SUCCEED, blackboard
     assert scene.grasp.picks == [("cup", (2.5, 0.0, 0.75))]
     carried, placed = scene.anchoring.expectations
     assert (carried.kind, carried.symbol, carried.position, carried.source) == (

@@ -13,7 +13,8 @@ from merlin2_sailor_behaviors.state_machines.outcomes import ABORT, CANCEL, SUCC
 from merlin2_sailor_behaviors.state_machines.state import CbState, State
 from merlin2_sailor_behaviors.state_machines.state_machine import StateMachine
 
-from .waiting_state import WAIT_SECONDS, WaitForCancel
+from .waiting_state import WAIT_SECONDS
+from .waiting_state import LocalWaitForCancel as WaitForCancel
 
 
 def record(name: str, outcome: str = SUCCEED) -> CbState:
