@@ -83,23 +83,33 @@ class KantNode:
 
 
 @pytest.fixture
-def kant_node(upstream_stack) -> Iterator[KantNode]:
-    """KANT's own knowledge-base node, unmodified, as a process in a namespace of this test's own."""
+def start_kant_node(upstream_stack) -> Iterator[Callable[[str], KantNode]]:
+    """Start KANT's own knowledge-base node, unmodified, as a process in a given namespace."""
     upstream_stack("kant_knowledge_base", "kant_msgs.srv", "simple_node")
-    namespace = f"/kant_{uuid.uuid4().hex[:12]}"
-    process = subprocess.Popen(
-        [sys.executable, "-m", KANT_NODE_MODULE, "--ros-args", "-r", f"__ns:={namespace}"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
-    )
-    try:
-        yield KantNode(f"kant+ros://{namespace}", process)
-    finally:
+    started: list[subprocess.Popen] = []
+
+    def start(namespace: str) -> KantNode:
+        process = subprocess.Popen(
+            [sys.executable, "-m", KANT_NODE_MODULE, "--ros-args", "-r", f"__ns:={namespace}"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+        )
+        started.append(process)
+        return KantNode(f"kant+ros://{namespace}", process)
+
+    yield start
+    for process in started:
         process.send_signal(signal.SIGINT)  # what ros2 launch sends; KANT's node ignores SIGTERM
         try:
             process.wait(timeout=10)
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
+
+
+@pytest.fixture
+def kant_node(start_kant_node) -> KantNode:
+    """KANT's knowledge-base node in a namespace of this test's own."""
+    return start_kant_node(f"/kant_{uuid.uuid4().hex[:12]}")
 
 
 # --- Fixtures for tests that talk to real nodes over DDS -----------------------------------

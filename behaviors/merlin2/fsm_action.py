@@ -36,6 +36,7 @@ from typing import Any
 
 from merlin2_sailor.errors import DependencyError
 from merlin2_sailor.knowledge import PddlAction
+from merlin2_sailor.knowledge.kant_projection import kant_duration
 from merlin2_sailor.knowledge.model import TimedLiteral
 from merlin2_sailor_behaviors.actions.context import BehaviorContext
 from merlin2_sailor_behaviors.actions.keys import PLAN_STEP_KEY, REASON_KEY
@@ -176,7 +177,10 @@ def sailor_fsm_action_class(api: Merlin2Api | None = None) -> type:
         create_efects = create_effects  # the spelling of MERLIN2 releases before 2023
 
         def save_action(self) -> bool:
-            """Declare the types and predicates first, then save the action as MERLIN2 does."""
+            """Declare the types and predicates first, then save the action, with its own duration
+            in KANT's whole seconds, as MERLIN2 does."""
+            if self.sailor_action.pddl.durative:
+                self.set_duration(kant_duration(self.sailor_action.pddl.duration))
             factory = self.dao_factory
             type_dao, predicate_dao = factory.create_pddl_type_dao(), factory.create_pddl_predicate_dao()
             for type_dto in self._sailor_dtos.types:

@@ -1,19 +1,26 @@
 """Start SAILOR's actions as MERLIN2 actions: ``python -m merlin2_sailor_behaviors.merlin2.run``.
 
 Each named action (all when none is named) becomes a MERLIN2 FSM action node under ``/merlin2``,
-registered in MERLIN2's knowledge base and run by MERLIN2's executor; Ctrl-C stops them and
-MERLIN2 withdraws the actions. The behaviours' settings are the defaults of
-config/behaviors.yaml; give another grounding file with ``--grounding PATH``.
+registered in MERLIN2's knowledge base (with its own duration) and run by MERLIN2's executor;
+Ctrl-C (or SIGTERM) withdraws every action from the knowledge base once, then exits 0. The
+behaviours' settings are the defaults of config/behaviors.yaml; give another grounding file with
+``--grounding PATH``.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 
 from merlin2_sailor.errors import SailorError
 from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+WITHDRAW_SECONDS = 15.0
+"""How long withdrawing every action from MERLIN2's knowledge base may take at exit."""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -31,37 +38,67 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
 
     import rclpy
-    from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+    from rclpy.executors import MultiThreadedExecutor
+    from rclpy.signals import SignalHandlerOptions
 
     from merlin2_sailor_behaviors.merlin2.context import ros_context_factory
 
-    rclpy.init()
+    # Ctrl-C is handled here, not by rclpy: rclpy's handler shuts ROS down at once, and then MERLIN2
+    # cannot withdraw the actions from its knowledge base (its DAO call fails on a dead context).
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    stop = threading.Event()
+    previous_handlers = {number: signal.signal(number, lambda *_: stop.set()) for number in STOP_SIGNALS}
     nodes: list = []
     executor = MultiThreadedExecutor()
     try:
         make_context = ros_context_factory(options.grounding)
         nodes = [action_class(action, make_context) for action in actions]
-        # MERLIN2's nodes (simple_node) spin themselves on executors of their own; a plain rclpy
-        # node is spun here.
+        # MERLIN2's nodes (simple_node) spin themselves on threads of their own; plain rclpy
+        # nodes are spun here.
         for node in nodes:
             if not hasattr(node, "join_spin"):
                 executor.add_node(node)
         if executor.get_nodes():
-            executor.spin()
-        elif nodes:
-            nodes[0].join_spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+            threading.Thread(target=executor.spin, name="sailor-actions", daemon=True).start()
+        print(f"running {', '.join(action.name for action in actions)} as MERLIN2 actions; Ctrl-C stops them",
+              flush=True)
+        while not stop.wait(timeout=1.0):
+            pass
     except SailorError as error:
         print(f"cannot start: {error}", file=sys.stderr)
         return 2
     finally:
+        withdrawn = withdraw(nodes)
         executor.shutdown()
-        for node in nodes:
-            node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+        for number, handler in previous_handlers.items():
+            signal.signal(number, handler)
+    return 0 if withdrawn else 1
 
+
+def withdraw(nodes: Sequence, deadline: float = WITHDRAW_SECONDS) -> bool:
+    """Destroy each node once, while ROS is still up, so MERLIN2 withdraws its action from KANT.
+
+    MERLIN2's withdrawal waits on KANT without a deadline; a knowledge base that does not answer
+    within ``deadline`` seconds is reported, and the process ends anyway.
+    """
+    def destroy_all() -> None:
+        for node in nodes:
+            try:
+                node.destroy_node()
+            except Exception as error:  # one action's failure must not keep the others registered
+                print(f"could not withdraw {node.get_name()}: {error}", file=sys.stderr)
+                failures.append(node)
+
+    failures: list = []
+    worker = threading.Thread(target=destroy_all, name="sailor-withdraw", daemon=True)
+    worker.start()
+    worker.join(deadline)
+    if worker.is_alive():
+        print(f"the knowledge base did not answer within {deadline:g} s: some actions may still be registered",
+              file=sys.stderr)
+        return False
+    return not failures
 
 if __name__ == "__main__":
     raise SystemExit(main())

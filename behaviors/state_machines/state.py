@@ -12,7 +12,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable
 
 from merlin2_sailor_behaviors.state_machines.blackboard import Blackboard
-from merlin2_sailor_behaviors.state_machines.errors import StateMachineError
+from merlin2_sailor_behaviors.state_machines.errors import StateMachineValueError
 
 StateCallback = Callable[[Blackboard], str]
 """What a :class:`CbState` runs: the blackboard in, an outcome out."""
@@ -21,16 +21,16 @@ StateCallback = Callable[[Blackboard], str]
 def _declared_outcomes(outcomes: Iterable[str], owner: str) -> tuple[str, ...]:
     """Validate a declaration of outcomes: a non-empty sequence of distinct, non-empty strings."""
     if isinstance(outcomes, str):
-        raise StateMachineError(f"{owner} outcomes must be a list of strings, got {outcomes!r}")
+        raise StateMachineValueError(f"{owner} outcomes must be a list of strings, got {outcomes!r}")
     declared = tuple(outcomes)
     if not declared:
-        raise StateMachineError(f"{owner} must declare at least one outcome")
+        raise StateMachineValueError(f"{owner} must declare at least one outcome")
     bad = [outcome for outcome in declared if not isinstance(outcome, str) or not outcome]
     if bad:
-        raise StateMachineError(f"{owner} outcomes must be non-empty strings, got {bad!r}")
+        raise StateMachineValueError(f"{owner} outcomes must be non-empty strings, got {bad!r}")
     duplicates = sorted({outcome for outcome in declared if declared.count(outcome) > 1})
     if duplicates:
-        raise StateMachineError(f"{owner} declares outcome(s) {duplicates} more than once")
+        raise StateMachineValueError(f"{owner} declares outcome(s) {duplicates} more than once")
     return declared
 
 
@@ -44,6 +44,7 @@ class State(ABC):
     def __init__(self, outcomes: Iterable[str]) -> None:
         self._outcomes = _declared_outcomes(outcomes, type(self).__name__)
         self._canceled = threading.Event()
+        self._running = threading.Event()
 
     @abstractmethod
     def execute(self, blackboard: Blackboard) -> str:
@@ -66,9 +67,13 @@ class State(ABC):
 
     def _run(self, blackboard: Blackboard) -> str:
         """Execute and check the outcome, without touching the cancellation flag."""
-        outcome = self.execute(blackboard)
+        self._running.set()
+        try:
+            outcome = self.execute(blackboard)
+        finally:
+            self._running.clear()
         if outcome not in self._outcomes:
-            raise StateMachineError(
+            raise StateMachineValueError(
                 f"{self} returned outcome {outcome!r}, which it does not declare; "
                 f"declare it or return one of {list(self._outcomes)}"
             )
@@ -82,6 +87,10 @@ class State(ABC):
         """Whether :meth:`cancel_state` was called since this run started."""
         return self._canceled.is_set()
 
+    def is_running(self) -> bool:
+        """Whether the state is executing now."""
+        return self._running.is_set()
+
     def get_outcomes(self) -> tuple[str, ...]:
         """The outcomes this state may end with, in declaration order."""
         return self._outcomes
@@ -93,11 +102,11 @@ class State(ABC):
 class CbState(State):
     """A state whose work is a plain function of the blackboard: the quickest way to a behaviour."""
 
-    def __init__(self, outcomes: Iterable[str], callback: StateCallback) -> None:
+    def __init__(self, outcomes: Iterable[str], cb: StateCallback) -> None:
         super().__init__(outcomes)
-        if not callable(callback):
-            raise StateMachineError(f"CbState callback must be callable, got {callback!r}")
-        self._callback = callback
+        if not callable(cb):
+            raise StateMachineValueError(f"CbState cb must be callable, got {cb!r}")
+        self._callback = cb
 
     def execute(self, blackboard: Blackboard) -> str:
         return self._callback(blackboard)

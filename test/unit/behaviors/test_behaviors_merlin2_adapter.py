@@ -10,6 +10,7 @@ They are injected into ``sys.modules``, so no MERLIN2 is needed.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import threading
 import types
@@ -89,6 +90,7 @@ class DaoFactory:
 class Merlin2Action:
     def __init__(self, a_name: str, durative: bool = True) -> None:
         self.action_name = a_name
+        self.duration = 10  # KANT's PddlActionDto default
         self.dao_factory = DaoFactory()
         self.parameters = self.create_parameters()
         self.effects = self.create_effects()
@@ -99,6 +101,9 @@ class Merlin2Action:
 
     def get_name(self) -> str:
         return self.action_name
+
+    def set_duration(self, duration: int) -> None:
+        self.duration = duration
 
     def save_action(self) -> bool:
         return self.dao_factory.create_pddl_action_dao().save(self)
@@ -162,6 +167,12 @@ def test_the_pddl_action_becomes_kant_dtos_saved_after_its_types_and_predicates(
     assert [e.text() for e in node.effects] == ["at start: not robot_at(origin)", "at end: robot_at(destination)"]
     saved = [type(dto).__name__ + ":" + dto.get_name() for dto in node.dao_factory.saved]
     assert saved == ["PddlTypeDto:wp", "PddlPredicateDto:robot_at", "SailorMerlin2FsmAction:navigation"]
+
+
+def test_each_action_is_registered_with_its_own_duration_in_whole_seconds(merlin2, robot: FakeRobot) -> None:
+    action = SAILOR_ACTIONS["navigation"]
+    slow = dataclasses.replace(action, pddl=dataclasses.replace(action.pddl, duration=42.5))
+    assert merlin2(slow, lambda node, stopping: robot.context).duration == 43
 
 
 def test_run_action_puts_the_goal_objects_under_the_parameter_names_and_runs_the_machine(
