@@ -44,6 +44,7 @@ from merlin2_sailor_behaviors.actions.robot_location import declare_robot_at, ro
 from merlin2_sailor_behaviors.actions.sailor_action import SailorAction
 from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.ros.anchoring_client import RosAnchoringClient
+from merlin2_sailor_behaviors.ros.fsm_viewer import VIEWER_PERIOD, FsmViewerPublisher
 from merlin2_sailor_behaviors.ros.grasp_client import RosGraspClient
 from merlin2_sailor_behaviors.ros.navigation_client import RosNavigationClient
 from merlin2_sailor_behaviors.ros.pddl_action_server import Body, PddlActionServer
@@ -131,6 +132,9 @@ class BehaviorsNode(Node):
             for action in self._actions
         ]
         self.create_timer(FEEDBACK_PERIOD, self._publish_progress, callback_group=group)
+        self._viewer = FsmViewerPublisher(self)
+        if self._viewer.enabled:
+            self.create_timer(VIEWER_PERIOD, self._publish_to_viewer, callback_group=group)
         self._registration = threading.Thread(
             target=self._register, args=(retry_period,), name="behaviors-registration", daemon=True)
         self._registration.start()
@@ -189,6 +193,11 @@ class BehaviorsNode(Node):
     def _publish_progress(self) -> None:
         for server in self._servers:
             server.publish_progress()
+
+    def _publish_to_viewer(self) -> None:
+        for server in self._servers:
+            for machine in server.running_machines():
+                self._viewer.publish(server.action.name, machine)
 
     def _log(self, level: str, message: str) -> None:
         # One call site per severity: rclpy refuses a call site whose severity changes.

@@ -114,6 +114,11 @@ class PddlActionServer:
     def destroy(self) -> None:
         self._server.destroy()
 
+    def running_machines(self) -> list[State]:
+        """The machines of the goals running now."""
+        with self._lock:
+            return [run.machine for run in self._runs.values() if run.machine is not None and run.result is None]
+
     def publish_progress(self) -> None:
         """Publish, as feedback, the state each running machine entered since the last call.
 

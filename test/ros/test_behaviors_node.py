@@ -131,7 +131,7 @@ def wait_until(condition, timeout: float = 20.0) -> bool:  # noqa: ANN001
     return condition()
 
 
-def test_behaviors_register_run_cancel_and_withdraw(node_process, tmp_path: Path) -> None:
+def test_behaviors_register_run_cancel_and_withdraw(node_process, ros_probe, tmp_path: Path) -> None:
     from merlin2_sailor.knowledge import PddlObject, PddlType, Proposition, Provenance
     from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_behaviors.actions import REASON_KEY
@@ -157,6 +157,7 @@ def test_behaviors_register_run_cancel_and_withdraw(node_process, tmp_path: Path
         "-p", f"robot_pose_topic:={world}/robot_pose", "-p", "look_dwell:=0.0",
         "-p", "registration_retry_period:=0.2")
     store = open_store(f"ros://{namespace}")
+    viewer_messages = _optional("yasmin_msgs.msg")
     try:
         def actions() -> set[str]:
             return {action.name for action in store.actions.get_all()}
@@ -184,6 +185,11 @@ def test_behaviors_register_run_cancel_and_withdraw(node_process, tmp_path: Path
             runner = threading.Thread(target=lambda: outcomes.append(navigation(blackboard)))
             runner.start()
             assert robot.driving.wait(10.0)
+            if viewer_messages is not None:  # where YASMIN's messages are installed, the viewer sees the run
+                layouts = ros_probe.collect(viewer_messages.StateMachine, "/fsm_viewer", 1, 10, timeout=10.0)
+                assert layouts and layouts[0].states[0].name == "navigation", behaviors.text
+                root = layouts[0].states[0]
+                assert root.is_fsm and root.current_state > 0
             navigation.cancel_state()
             runner.join(10.0)
             assert outcomes == [CANCEL] and robot.cancelled.is_set(), blackboard[REASON_KEY]
@@ -200,3 +206,13 @@ def test_behaviors_register_run_cancel_and_withdraw(node_process, tmp_path: Path
         assert store.predicates.get("robot_at") is not None  # declarations stay for the facts
     finally:
         store.close()
+
+
+def _optional(module_name: str):  # noqa: ANN202
+    """The module, or None where it is not installed (yasmin_msgs comes with SAILOR_UPSTREAM)."""
+    import importlib
+
+    try:
+        return importlib.import_module(module_name)
+    except ImportError:
+        return None
