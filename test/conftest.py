@@ -71,6 +71,7 @@ def upstream_stack() -> Callable[..., None]:
 
 
 KANT_NODE_MODULE = "kant_knowledge_base.knowledge_base_node_main"
+KANT_START_SECONDS = 30.0
 """KANT's knowledge-base node, MERLIN2's knowledge base, as ``ros2 run kant_knowledge_base`` starts it."""
 
 
@@ -94,7 +95,14 @@ def start_kant_node(upstream_stack) -> Iterator[Callable[[str], KantNode]]:
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
         )
         started.append(process)
-        return KantNode(f"kant+ros://{namespace}", process)
+        node = KantNode(f"kant+ros://{namespace}", process)
+        # Ready when a KANT store can read it: the tests' own deadlines then measure the tests,
+        # not the node's start on a busy machine.
+        from merlin2_sailor.ros.stores import open_store
+
+        with open_store(node.location, timeout=KANT_START_SECONDS):
+            pass
+        return node
 
     yield start
     for process in started:
