@@ -10,10 +10,12 @@ behaviours' settings are the defaults of config/behaviors.yaml; give another gro
 from __future__ import annotations
 
 import argparse
+import contextlib
 import signal
 import sys
 import threading
-from collections.abc import Sequence
+import time
+from collections.abc import Iterator, Sequence
 
 from merlin2_sailor.errors import SailorError
 from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
@@ -21,6 +23,10 @@ from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 WITHDRAW_SECONDS = 15.0
 """How long withdrawing every action from MERLIN2's knowledge base may take at exit."""
+THREAD_END_SECONDS = 2.0
+"""How long each of MERLIN2's node threads may take to end once ROS has shut down."""
+STOP_POLL_SECONDS = 0.2
+"""How often the main thread looks for a stop request while the actions run."""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -46,13 +52,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     # Ctrl-C is handled here, not by rclpy: rclpy's handler shuts ROS down at once, and then MERLIN2
     # cannot withdraw the actions from its knowledge base (its DAO call fails on a dead context).
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    stop = threading.Event()
-    previous_handlers = {number: signal.signal(number, lambda *_: stop.set()) for number in STOP_SIGNALS}
+    stop = StopRequest()
+    previous_handlers = {number: signal.signal(number, stop) for number in STOP_SIGNALS}
     nodes: list = []
     executor = MultiThreadedExecutor()
     try:
         make_context = ros_context_factory(options.grounding)
-        nodes = [action_class(action, make_context) for action in actions]
+        for action in actions:  # one by one, so an interrupted start withdraws those already made
+            nodes.append(action_class(action, make_context))
         # MERLIN2's nodes (simple_node) spin themselves on threads of their own; plain rclpy
         # nodes are spun here.
         for node in nodes:
@@ -62,18 +69,72 @@ def main(argv: Sequence[str] | None = None) -> int:
             threading.Thread(target=executor.spin, name="sailor-actions", daemon=True).start()
         print(f"running {', '.join(action.name for action in actions)} as MERLIN2 actions; Ctrl-C stops them",
               flush=True)
-        while not stop.wait(timeout=1.0):
-            pass
+        stop.running = True
+        while not stop.requested:
+            time.sleep(STOP_POLL_SECONDS)
     except SailorError as error:
         print(f"cannot start: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("interrupted while starting", file=sys.stderr)
+        return 130
     finally:
         withdrawn = withdraw(nodes)
         executor.shutdown()
-        rclpy.try_shutdown()
+        with ros_shutdown_ends_node_threads():
+            rclpy.try_shutdown()
+            let_node_threads_end(nodes)
         for number, handler in previous_handlers.items():
             signal.signal(number, handler)
     return 0 if withdrawn else 1
+
+
+@contextlib.contextmanager
+def ros_shutdown_ends_node_threads() -> Iterator[None]:
+    """While ROS shuts down, a node thread that ends with ROS's "context is not valid" has ended as
+    it should (simple_node's executor threads spin until the context dies, and say so with an
+    RCLError); any other exception in a thread is reported as usual."""
+    from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
+    from rclpy.executors import ExternalShutdownException
+
+    report = threading.excepthook
+
+    def hook(arguments: threading.ExceptHookArgs) -> None:
+        if not issubclass(arguments.exc_type, (RCLError, InvalidHandle, ExternalShutdownException)):
+            report(arguments)
+
+    threading.excepthook = hook
+    try:
+        yield
+    finally:
+        threading.excepthook = report
+
+
+def let_node_threads_end(nodes: Sequence, timeout: float = THREAD_END_SECONDS) -> None:
+    """Give simple_node's spin and wake threads the moment they need to see ROS shut down: daemon
+    threads cut off by the interpreter's exit print a stray "Exception in thread"."""
+    for node in nodes:
+        for attribute in ("_spin_thread", "_wake_thread"):  # simple_node's, where it is used
+            thread = getattr(node, attribute, None)
+            if isinstance(thread, threading.Thread) and thread is not threading.current_thread():
+                thread.join(timeout)
+
+
+class StopRequest:
+    """The SIGINT / SIGTERM handler: a stop request once the actions run, an interrupt before.
+
+    It only sets a flag, which the main thread polls: a handler that takes a lock (Event.set) can
+    deadlock against the main thread holding that very lock when the signal arrives.
+    """
+
+    def __init__(self) -> None:
+        self.running = False
+        self.requested = False
+
+    def __call__(self, signal_number: int, frame: object) -> None:
+        if not self.running:
+            raise KeyboardInterrupt  # still starting (MERLIN2 may wait for KANT): stop that
+        self.requested = True
 
 
 def withdraw(nodes: Sequence, deadline: float = WITHDRAW_SECONDS) -> bool:
