@@ -11,12 +11,12 @@ changes through the DAOs in dependency order. What KANT cannot hold is said plai
 
 * no transactions: a batch that fails half-way leaves the changes written so far (in dependency
   order, so the knowledge base stays consistent);
-* no supertypes: types are flat, children of ``object``;
-* no provenance: facts this adapter wrote keep theirs while it runs; others read as DECLARED.
+* no subtypes, whole-second durations, no provenance: :mod:`.kant_projection` decides what KANT
+  is given instead, and what this adapter remembers of what it wrote.
 
-By location, ``kant+mongodb://host:port/database`` opens KANT's MongoDB DAO family on that URI.
-KANT's ROS 2 family needs a ROS node of the caller's: build its factory and pass it to
-:class:`KantStore` directly.
+By location, ``kant+mongodb://host:port/database`` opens KANT's MongoDB DAO family on that URI;
+``kant+ros:///namespace`` (:mod:`merlin2_sailor.ros.kant_ros_store`) its ROS 2 family, KANT's own
+node, from ROS nodes and ``sailor`` commands.
 """
 
 from __future__ import annotations
