@@ -236,12 +236,16 @@ class Dispatcher:
             outcome = behaviour(blackboard)
         except Exception as error:  # a bug in a behaviour: replanning would only repeat it
             self._write(lambda: self._effects.undo(applied))
+            # A machine cancelled between two of its states raises (YASMIN 3.2 does, and so does
+            # the local implementation): a cancel this dispatcher made is still a cancel, not a bug.
             if self._cancel_requested.is_set():
-                # Real YASMIN raises when a cancel meets a machine that does not end in
-                # ``canceled`` (a state's outcome with no transition, or a cancel between states):
-                # the mission was still cancelled, not failed.
                 _logger.info("%s raised %r while being cancelled", step.step, error)
                 return _Run(_Ending.CANCELED, f"cancelled during {step.step}")
+            with self._lock:
+                retraction = self._retraction
+            if retraction is not None and step_was_cancelled(behaviour):
+                _logger.info("%s raised %r while being cancelled for a retraction", step.step, error)
+                return _Run(_Ending.REPLAN, retraction)
             return _Run(_Ending.FAILED, f"behaviour of {step.step} raised {error!r}")
         finally:
             with self._lock:
@@ -329,3 +333,9 @@ class Dispatcher:
         cancel = getattr(behaviour, "cancel_state", None)
         if callable(cancel):
             cancel()
+
+
+def step_was_cancelled(behaviour: Behaviour | None) -> bool:
+    """Whether the behaviour was cancelled during its run (states and machines say so)."""
+    is_canceled = getattr(behaviour, "is_canceled", None)
+    return bool(is_canceled()) if callable(is_canceled) else False

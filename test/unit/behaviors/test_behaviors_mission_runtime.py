@@ -7,6 +7,7 @@ condition, so that a retracted corridor changes which plans exist.
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from collections.abc import Callable, Iterator
 
@@ -39,8 +40,10 @@ from merlin2_sailor_behaviors.planning import (  # noqa: E402
 )
 from merlin2_sailor_behaviors.state_machines import (  # noqa: E402
     ABORT,
+    CANCEL,
     SUCCEED,
     Blackboard,
+    CbState,
     StateMachine,
 )
 
@@ -233,6 +236,37 @@ def test_replans_when_a_fact_the_plan_relies_on_is_retracted_mid_plan(
     first_plan_second_step = result.plans[0].steps[1]
     assert first_plan_second_step.objects == retracted[0]
     assert retracted[0] not in [step.objects for step in result.executed]
+    assert robot_at(store) == ["d"]
+
+
+def test_a_machine_cancelled_between_its_states_by_a_retraction_replans_the_mission(
+    store: KnowledgeBase, planner: Planner
+) -> None:
+    # The corridor is needed over the whole drive, so retracting it cancels the running machine;
+    # the cancel lands between its two states, where YASMIN 3.2 (and the local subset) raise.
+    store.actions.save(dataclasses.replace(navigation(), conditions=(
+        Condition("robot_at", ("origin",), "at start"),
+        Condition("connected", ("origin", "destination"), "over all"),
+    )))
+    blocked: list[tuple[str, str]] = []
+
+    def drive(blackboard: Blackboard) -> str:
+        if not blocked:
+            corridor = (blackboard["origin"], blackboard["destination"])
+            blocked.append(corridor)
+            perception = threading.Thread(target=store.propositions.delete,
+                                          args=(Proposition("connected", corridor),))
+            perception.start()
+            perception.join(WAIT_SECONDS)
+        return SUCCEED
+
+    machine = StateMachine([SUCCEED, ABORT, CANCEL])
+    machine.add_state("DRIVE", CbState([SUCCEED], drive), {SUCCEED: "ARRIVE"})
+    machine.add_state("ARRIVE", CbState([SUCCEED], succeed))
+    result = runner(store, planner, machine).run(goal("d"))
+    assert result.status is MissionStatus.SUCCEEDED, result.reason
+    assert result.replans == 1 and blocked
+    assert blocked[0] not in [step.objects for step in result.executed]
     assert robot_at(store) == ["d"]
 
 
