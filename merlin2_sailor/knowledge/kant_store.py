@@ -46,10 +46,11 @@ KANT_MISSING = (
 
 
 def import_kant_dto() -> ModuleType:
-    return _import_kant("kant_dto")
+    return import_kant_module("kant_dto")
 
 
-def _import_kant(module_name: str) -> ModuleType:
+def import_kant_module(module_name: str) -> ModuleType:
+    """A module of KANT (or of what it needs), or a DependencyError saying how to get KANT."""
     try:
         return importlib.import_module(module_name)
     except ImportError as error:
@@ -86,7 +87,7 @@ class KantStore(MirroredStore):
             raise ConfigurationError(
                 f"{location!r} names no KANT database; write kant+mongodb://host:port/database"
             )
-        dao_factory_module = _import_kant("kant_dao.dao_factory")
+        dao_factory_module = import_kant_module("kant_dao.dao_factory")
         families = dao_factory_module.DaoFamilies
         return cls(dao_factory_module.DaoFactoryMethod().create_dao_factory(families.MONGO, uri=uri))
 

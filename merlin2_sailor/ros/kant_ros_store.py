@@ -15,16 +15,15 @@ and, a daemon, it does not keep the process from exiting.
 
 from __future__ import annotations
 
-import importlib
 import threading
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
 import rclpy
 
-from merlin2_sailor.errors import DependencyError, KnowledgeError
+from merlin2_sailor.errors import KnowledgeError
 from merlin2_sailor.knowledge.changes import ChangeEvent
-from merlin2_sailor.knowledge.kant_store import KANT_MISSING, KantStore
+from merlin2_sailor.knowledge.kant_store import KantStore, import_kant_module
 from merlin2_sailor.knowledge.store import DEFAULT_TIMEOUT_SECONDS
 from merlin2_sailor.ros.background_spinner import BackgroundSpinner
 
@@ -41,8 +40,8 @@ class KantRosStore(KantStore):
     """KANT's ROS 2 DAO family over a node of this store's own, with a deadline on every exchange."""
 
     def __init__(self, namespace: str = "/", timeout: float = DEFAULT_TIMEOUT_SECONDS) -> None:
-        dao_factory_module = _import("kant_dao.dao_factory")
-        service_type = _import("std_srvs.srv").Empty
+        dao_factory_module = import_kant_module("kant_dao.dao_factory")
+        service_type = import_kant_module("std_srvs.srv").Empty
         self._timeout = timeout
         self._namespace = "/" + namespace.strip("/")
         self._spinner = BackgroundSpinner("kant-store")
@@ -102,9 +101,3 @@ class KantRosStore(KantStore):
     def _close_database(self) -> None:
         self._spinner.close()
 
-
-def _import(module_name: str) -> Any:
-    try:
-        return importlib.import_module(module_name)
-    except ImportError as error:
-        raise DependencyError(f"{KANT_MISSING} ({error})") from error
