@@ -49,12 +49,16 @@ from merlin2_sailor.ros.conversions import (
     pose_to_message,
     seconds_to_stamp,
 )
+from merlin2_sailor.ros.navigation_interface import (
+    NavigationErrorCode,
+    navigate_to_pose_type,
+    navigation_interface_name,
+)
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import LATCHED, SENSOR_DATA
 from merlin2_sailor_demos.world import DetectorNoise, NavigationState, World, load_world
 from merlin2_sailor_demos.world.markers import MarkerItem, world_markers, yaw_to_quaternion
-from merlin2_sailor_interfaces.action import NavigateToPose
 from merlin2_sailor_interfaces.msg import DetectionArray
 from merlin2_sailor_interfaces.srv import Grasp
 
@@ -135,8 +139,9 @@ class WorldNode(Node):
         self._marker_publisher = self.create_publisher(MarkerArray, "world_markers", LATCHED)
 
         servers = ReentrantCallbackGroup()
+        self._navigation = navigate_to_pose_type()
         self._action_server = ActionServer(
-            self, NavigateToPose, "navigate_to_pose", execute_callback=self._navigate,
+            self, self._navigation, "navigate_to_pose", execute_callback=self._navigate,
             goal_callback=lambda _goal: GoalResponse.ACCEPT, cancel_callback=lambda _goal: CancelResponse.ACCEPT,
             callback_group=servers,
         )
@@ -152,7 +157,7 @@ class WorldNode(Node):
             f"world '{path.name}' ({len(self._world.objects)} objects, waypoints "
             f"{', '.join(w.name for w in self._world.house.waypoints)}) at {rate_hz:g} Hz, "
             f"render {'on' if self._render else 'off'}, ground-truth detections "
-            f"{'on' if self._publish_detections else 'off'}"
+            f"{'on' if self._publish_detections else 'off'}; navigation serves {navigation_interface_name()}"
         )
 
     # --- the simulation loop ----------------------------------------------------------------------
@@ -239,7 +244,7 @@ class WorldNode(Node):
 
     # --- navigation -------------------------------------------------------------------------------
 
-    def _navigate(self, goal_handle) -> NavigateToPose.Result:
+    def _navigate(self, goal_handle) -> object:
         with self._goals_done:
             self._running_goals += 1
         try:
@@ -248,13 +253,13 @@ class WorldNode(Node):
             self.get_logger().error(f"navigation failed:\n{traceback.format_exc()}")
             if goal_handle.is_active:
                 goal_handle.abort()
-            return NavigateToPose.Result(error_code=NavigateToPose.Result.UNKNOWN, error_msg="internal error")
+            return self._navigation.Result(error_code=NavigationErrorCode.UNKNOWN, error_msg="internal error")
         finally:
             with self._goals_done:
                 self._running_goals -= 1
                 self._goals_done.notify_all()
 
-    def _run_navigation(self, goal_handle) -> NavigateToPose.Result:
+    def _run_navigation(self, goal_handle) -> object:
         request = goal_handle.request.pose
         position, orientation = request.pose.position, request.pose.orientation
         try:
@@ -267,7 +272,7 @@ class WorldNode(Node):
         except InvalidInputError as error:
             self.get_logger().warning(f"navigation goal refused: {error}")
             goal_handle.abort()
-            return NavigateToPose.Result(error_code=NavigateToPose.Result.UNKNOWN, error_msg=str(error))
+            return self._navigation.Result(error_code=NavigationErrorCode.UNKNOWN, error_msg=str(error))
         via = f" via {', '.join(plan.nodes)}" if plan.nodes else ""
         self.get_logger().info(
             f"navigating to ({position.x:.2f}, {position.y:.2f}){via}, {plan.length:.1f} m"
@@ -277,13 +282,14 @@ class WorldNode(Node):
             time.sleep(FEEDBACK_PERIOD)
             if self._closing.is_set():
                 goal_handle.abort()
-                return NavigateToPose.Result(error_code=NavigateToPose.Result.UNKNOWN, error_msg="world shutting down")
+                return self._navigation.Result(error_code=NavigationErrorCode.UNKNOWN,
+                                               error_msg="world shutting down")
             if goal_handle.is_cancel_requested:
                 with self._lock:
                     self._world.cancel_navigation(goal.id)
                 goal_handle.canceled()
                 self.get_logger().info("navigation canceled")
-                return NavigateToPose.Result(error_code=NavigateToPose.Result.CANCELED, error_msg="canceled")
+                return self._navigation.Result(error_code=NavigationErrorCode.CANCELED, error_msg="canceled")
             with self._lock:
                 state = goal.state
                 estimate = self._world.estimated_pose
@@ -293,10 +299,10 @@ class WorldNode(Node):
                 goal_handle.succeed()
                 self.get_logger().info(f"arrived at ({estimate.x:.2f}, {estimate.y:.2f}) after "
                                        f"{elapsed_simulated:.1f} s")
-                return NavigateToPose.Result(error_code=NavigateToPose.Result.NONE)
+                return self._navigation.Result(error_code=NavigationErrorCode.NONE)
             if state is not NavigationState.ACTIVE:
                 goal_handle.abort()
-                return NavigateToPose.Result(error_code=NavigateToPose.Result.UNKNOWN,
+                return self._navigation.Result(error_code=NavigationErrorCode.UNKNOWN,
                                              error_msg=f"goal {state.value} by a newer goal")
             if time.monotonic() - started > self._navigation_timeout:
                 with self._lock:
@@ -304,8 +310,8 @@ class WorldNode(Node):
                 goal_handle.abort()
                 message = f"not there after {self._navigation_timeout:g} s"
                 self.get_logger().warning(f"navigation timed out: {message}")
-                return NavigateToPose.Result(error_code=NavigateToPose.Result.TIMEOUT, error_msg=message)
-            feedback = NavigateToPose.Feedback(distance_remaining=float(remaining))
+                return self._navigation.Result(error_code=NavigationErrorCode.TIMEOUT, error_msg=message)
+            feedback = self._navigation.Feedback(distance_remaining=float(remaining))
             feedback.current_pose = PoseStamped(
                 header=Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame),
                 pose=_planar_pose(estimate.x, estimate.y, estimate.yaw))

@@ -44,19 +44,64 @@ interfaces=(
   text_to_speech/text_to_speech_msgs
   speech_to_text/speech_to_text_msgs
 )
+# Interface packages of which only part builds here: name, then the interface files generated
+# (Nav2's nav2_msgs also needs geographic_msgs, which the ROS 2 wheels lack; NavigateToPose does not).
+subset_name=nav2_msgs
+subset_source=navigation2/nav2_msgs
+subset_files=(action/NavigateToPose.action)
+subset_depends=(std_msgs builtin_interfaces geometry_msgs action_msgs)
 # Projects whose Python packages go on the path as they are in the checkout.
 python_projects=(kant yasmin simple_node merlin2 waypoint_navigation)
 
-for package in "${interfaces[@]}"; do
+for package in "${interfaces[@]}" "$subset_source"; do
   [ -f "$upstream/$package/package.xml" ] || die "$upstream/$package is missing; SAILOR_UPSTREAM must \
 hold the layout of ../shared/upstream (see its README)"
 done
+
+# A package of our own that generates only subset_files, read in place from the upstream package
+# (rosidl's "base:relative" form), so nothing of it is copied.
+write_subset_package() {
+  local folder="$1" file interfaces_list="" depends_xml="" depends_list=""
+  rm -rf "$folder" && mkdir -p "$folder"
+  for file in "${subset_files[@]}"; do interfaces_list+=" \"$upstream/$subset_source:$file\""; done
+  for file in "${subset_depends[@]}"; do
+    depends_xml+="  <depend>$file</depend>"$'\n'
+    depends_list+=" $file"
+  done
+  cat > "$folder/package.xml" <<XML
+<?xml version="1.0"?>
+<package format="3">
+  <name>$subset_name</name>
+  <version>0.0.0</version>
+  <description>Part of $subset_source (${subset_files[*]}), built for SAILOR's compatibility tests.</description>
+  <maintainer email="none@example.com">merlin2_sailor tests</maintainer>
+  <license>Apache-2.0</license>
+  <buildtool_depend>ament_cmake</buildtool_depend>
+  <buildtool_depend>rosidl_default_generators</buildtool_depend>
+$depends_xml  <member_of_group>rosidl_interface_packages</member_of_group>
+  <export><build_type>ament_cmake</build_type></export>
+</package>
+XML
+  cat > "$folder/CMakeLists.txt" <<CMAKE
+cmake_minimum_required(VERSION 3.8)
+project($subset_name)
+find_package(ament_cmake REQUIRED)
+find_package(rosidl_default_generators REQUIRED)
+foreach(dependency$depends_list)
+  find_package(\${dependency} REQUIRED)
+endforeach()
+rosidl_generate_interfaces(\${PROJECT_NAME}$interfaces_list DEPENDENCIES$depends_list)
+ament_export_dependencies(rosidl_default_runtime)
+ament_package()
+CMAKE
+}
 
 sources_hash="$(
   { sha256sum "${BASH_SOURCE[0]}" "$venv/.sailor-deps.sha" 2>/dev/null || true
     for package in "${interfaces[@]}"; do
       find "$upstream/$package" -type f -print0 | sort -z | xargs -0 sha256sum
-    done; } | sha256sum | cut -d' ' -f1
+    done
+    for file in "${subset_files[@]}"; do sha256sum "$upstream/$subset_source/$file"; done; } | sha256sum | cut -d' ' -f1
 )"
 
 if [ ! -f "$out/.built.sha" ] || [ "$(cat "$out/.built.sha")" != "$sources_hash" ]; then
@@ -65,11 +110,14 @@ if [ ! -f "$out/.built.sha" ] || [ "$(cat "$out/.built.sha")" != "$sources_hash"
   "$venv/bin/python" "$root/scripts/fix_ros_cmake_paths.py" "$venv" >&2
   # rosidl finds its type supports through the ament index: the venv's, then what is built here.
   export AMENT_PREFIX_PATH="$prefix:$venv"
-  for package in "${interfaces[@]}"; do
-    name="$(basename "$package")"
+  write_subset_package "$out/subsets/$subset_name"
+  for package in "${interfaces[@]}" "subset:$subset_name"; do
+    name="$(basename "${package#subset:}")"
+    source_folder="$upstream/$package"
+    [ "${package#subset:}" != "$package" ] && source_folder="$out/subsets/$name"
     log="$out/$name.log"
     say "  $name"
-    if ! { "$venv/bin/cmake" -S "$upstream/$package" -B "$out/packages/$name" \
+    if ! { "$venv/bin/cmake" -S "$source_folder" -B "$out/packages/$name" \
              -DCMAKE_PREFIX_PATH="$prefix;$venv" -DCMAKE_INSTALL_PREFIX="$prefix" \
              -DPython3_EXECUTABLE="$venv/bin/python" -DBUILD_TESTING=OFF \
            && "$venv/bin/cmake" --build "$out/packages/$name" -j "$(nproc 2>/dev/null || echo 2)" \

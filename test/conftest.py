@@ -64,7 +64,7 @@ def require_upstream(*modules: str) -> None:
                         f"({error}); run the tests through `make test`, which sources scripts/upstream_env.sh")
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def upstream_stack() -> Callable[..., None]:
     """:func:`require_upstream`, for tests that need the real MERLIN2 stack."""
     return require_upstream

@@ -133,10 +133,13 @@ class NavigationResult:
 
 
 class NavigationPort(Protocol):
-    """Nav2's NavigateToPose, plus the robot's current pose."""
+    """Nav2's NavigateToPose (and MERLIN2's waypoint navigation, where the robot has it), plus the
+    robot's current pose."""
 
-    def navigate(self, goal: Pose2D, should_cancel: Callable[[], bool]) -> NavigationResult:
-        """Drive to ``goal`` and wait; cancel the goal as soon as ``should_cancel()`` is true."""
+    def navigate(self, goal: Pose2D, should_cancel: Callable[[], bool], waypoint: str = "") -> NavigationResult:
+        """Drive to ``goal`` and wait; cancel the goal as soon as ``should_cancel()`` is true.
+        ``waypoint`` names ``goal`` when it is a waypoint of the map, for a navigation that drives
+        to waypoints by name."""
         ...
 
     def robot_pose(self) -> Pose2D | None:

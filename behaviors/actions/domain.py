@@ -11,7 +11,7 @@ written by the anchoring layer's grounding from what the camera sees; ``explored
 
 Actions (durative, MERLIN2's default duration):
 
-* ``navigation(?origin ?destination - wp)``, MERLIN2's own;
+* ``navigation(?o ?d - wp)``, MERLIN2's own (its signature, parameter names included: origin, destination);
 * ``explore(?waypoint - wp)``: look all around a waypoint;
 * ``approach_object(?target - object ?waypoint - wp)``: face an object and see it again;
 * ``find_object(?target - object ?origin - wp)``: search for a missing object; the robot ends
@@ -51,13 +51,17 @@ PREDICATES = MappingProxyType(
 
 START, END, OVER_ALL = "at start", "at end", "over all"
 
+NAVIGATION_ORIGIN, NAVIGATION_DESTINATION = "o", "d"
+"""navigation's parameter names: MERLIN2's own (merlin2_basic_actions), so that SAILOR's navigation
+is the same PDDL action as the one it replaces, down to what KANT stores."""
+
 NAVIGATION = PddlAction(
     "navigation",
-    (Parameter("origin", LOCATION_TYPE), Parameter("destination", LOCATION_TYPE)),
-    (Condition(ROBOT_AT, ("origin",), START),),
+    (Parameter(NAVIGATION_ORIGIN, LOCATION_TYPE), Parameter(NAVIGATION_DESTINATION, LOCATION_TYPE)),
+    (Condition(ROBOT_AT, (NAVIGATION_ORIGIN,), START),),
     (
-        Effect(ROBOT_AT, ("origin",), START, is_negative=True),
-        Effect(ROBOT_AT, ("destination",), END),
+        Effect(ROBOT_AT, (NAVIGATION_ORIGIN,), START, is_negative=True),
+        Effect(ROBOT_AT, (NAVIGATION_DESTINATION,), END),
     ),
 )
 

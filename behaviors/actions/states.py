@@ -34,6 +34,9 @@ class Target:
 
     name: str
     pose: Pose2D
+    waypoint: str = ""
+    """The map's name of this place when it is one of its waypoints: a robot with a waypoint
+    navigation (MERLIN2's NavigateToWp) is sent there by name, with the waypoint's own pose."""
 
 
 def abort(blackboard: Blackboard, reason: str) -> str:
@@ -142,7 +145,7 @@ class GoTo(BehaviorState):
 
 def drive(state: BehaviorState, target: Target) -> tuple[str, str]:
     """Send one NavigateToPose goal from ``state``; its outcome, and why when it aborted."""
-    result = state.context.navigation.navigate(target.pose, state.is_canceled)
+    result = state.context.navigation.navigate(target.pose, state.is_canceled, target.waypoint)
     if result.status is NavigationStatus.ARRIVED:
         return SUCCEED, ""
     if result.status is NavigationStatus.CANCELED or state.is_canceled():
@@ -215,13 +218,14 @@ def place_target(context: BehaviorContext, place_name: str) -> Target:
         BehaviorError: the map has no such place.
     """
     place = context.places.get(place_name)
+    waypoint = place.name if place.is_waypoint else ""  # a region's centre is driven to as a pose
     if place.yaw is not None:
-        return Target(place.name, Pose2D(place.x, place.y, place.yaw))
+        return Target(place.name, Pose2D(place.x, place.y, place.yaw), waypoint)
     robot = context.navigation.robot_pose()
     if robot is None:
-        return Target(place.name, Pose2D(place.x, place.y, 0.0))
+        return Target(place.name, Pose2D(place.x, place.y, 0.0), waypoint)
     arrival = Pose2D(robot.x, robot.y, robot.yaw).facing(place.x, place.y)
-    return Target(place.name, Pose2D(place.x, place.y, arrival.yaw))
+    return Target(place.name, Pose2D(place.x, place.y, arrival.yaw), waypoint)
 
 
 def robot_pose_or(context: BehaviorContext, place_name: str) -> Pose2D:

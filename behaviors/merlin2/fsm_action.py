@@ -156,12 +156,15 @@ def sailor_fsm_action_class(api: Merlin2Api | None = None) -> type:
             self._sailor_stopping = threading.Event()
             super().__init__(sailor_action.name)
             machine_name = sailor_action.name.upper()
-            self.add_state("READING_GOAL", CbState([SUCCEED, ABORT], self._read_goal), {SUCCEED: machine_name})
+            # MERLIN2 publishes the machine to YASMIN's viewer on a timer from now on, validating it
+            # each time: every state is added with transitions that already lead somewhere.
             self.add_state(
                 machine_name,
                 sailor_action.make_state_machine(make_context(self, self._sailor_stopping)),
                 {SUCCEED: SUCCEED, ABORT: ABORT, CANCEL: CANCEL},
             )
+            self.add_state("READING_GOAL", CbState([SUCCEED, ABORT], self._read_goal), {SUCCEED: machine_name})
+            self.set_start_state("READING_GOAL")
 
         # MERLIN2's PDDL hooks.
 

@@ -2,6 +2,7 @@
 
 Each named action (all when none is named) becomes a MERLIN2 FSM action node under ``/merlin2``,
 registered in MERLIN2's knowledge base (with its own duration) and run by MERLIN2's executor;
+waypoints are driven to through MERLIN2's waypoint navigation where it is installed;
 Ctrl-C (or SIGTERM) withdraws every action from the knowledge base once, then exits 0. The
 behaviours' settings are the defaults of config/behaviors.yaml; give another grounding file with
 ``--grounding PATH``.
@@ -10,21 +11,23 @@ behaviours' settings are the defaults of config/behaviors.yaml; give another gro
 from __future__ import annotations
 
 import argparse
-import contextlib
 import signal
 import sys
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
+
+from rclpy.utilities import remove_ros_args
 
 from merlin2_sailor.errors import SailorError
+from merlin2_sailor.ros.navigation_interface import WAYPOINT_NAVIGATION_ACTION
+from merlin2_sailor_behaviors.actions.context import BehaviorConfig
 from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
+from merlin2_sailor_behaviors.merlin2.node_threads import let_node_threads_end, ros_shutdown_ends_node_threads
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 WITHDRAW_SECONDS = 15.0
 """How long withdrawing every action from MERLIN2's knowledge base may take at exit."""
-THREAD_END_SECONDS = 2.0
-"""How long each of MERLIN2's node threads may take to end once ROS has shut down."""
 STOP_POLL_SECONDS = 0.2
 """How often the main thread looks for a stop request while the actions run."""
 
@@ -33,7 +36,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("actions", nargs="*", help=f"actions to run, of {list(SAILOR_ACTIONS)} (default: all)")
     parser.add_argument("--grounding", default="", help="grounding YAML with the map (default: config/grounding.yaml)")
-    options = parser.parse_args(argv)
+    parser.add_argument(
+        "--waypoint-navigation", default=None, metavar="ACTION",
+        help=f"NavigateToWp server to drive to waypoints by name (default: {WAYPOINT_NAVIGATION_ACTION} where "
+             "waypoint_navigation_msgs is installed; '' drives to them with NavigateToPose)")
+    parser.add_argument("--look-dwell", type=float, default=BehaviorConfig.look_dwell, metavar="SECONDS",
+                        help="seconds to stand still after each turn when looking around (default: %(default)s)")
+    arguments = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
+    options = parser.parse_args(remove_ros_args(arguments)[1:])  # --ros-args ... are ROS's
     try:
         from merlin2_sailor_behaviors.merlin2.fsm_action import sailor_fsm_action_class
 
@@ -51,13 +61,15 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     # Ctrl-C is handled here, not by rclpy: rclpy's handler shuts ROS down at once, and then MERLIN2
     # cannot withdraw the actions from its knowledge base (its DAO call fails on a dead context).
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    rclpy.init(args=arguments, signal_handler_options=SignalHandlerOptions.NO)
     stop = StopRequest()
     previous_handlers = {number: signal.signal(number, stop) for number in STOP_SIGNALS}
     nodes: list = []
     executor = MultiThreadedExecutor()
     try:
-        make_context = ros_context_factory(options.grounding)
+        make_context = ros_context_factory(
+            options.grounding, config=BehaviorConfig(look_dwell=options.look_dwell),
+            waypoint_action=options.waypoint_navigation)
         for action in actions:  # one by one, so an interrupted start withdraws those already made
             nodes.append(action_class(action, make_context))
         # MERLIN2's nodes (simple_node) spin themselves on threads of their own; plain rclpy
@@ -87,37 +99,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         for number, handler in previous_handlers.items():
             signal.signal(number, handler)
     return 0 if withdrawn else 1
-
-
-@contextlib.contextmanager
-def ros_shutdown_ends_node_threads() -> Iterator[None]:
-    """While ROS shuts down, a node thread that ends with ROS's "context is not valid" has ended as
-    it should (simple_node's executor threads spin until the context dies, and say so with an
-    RCLError); any other exception in a thread is reported as usual."""
-    from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
-    from rclpy.executors import ExternalShutdownException
-
-    report = threading.excepthook
-
-    def hook(arguments: threading.ExceptHookArgs) -> None:
-        if not issubclass(arguments.exc_type, (RCLError, InvalidHandle, ExternalShutdownException)):
-            report(arguments)
-
-    threading.excepthook = hook
-    try:
-        yield
-    finally:
-        threading.excepthook = report
-
-
-def let_node_threads_end(nodes: Sequence, timeout: float = THREAD_END_SECONDS) -> None:
-    """Give simple_node's spin and wake threads the moment they need to see ROS shut down: daemon
-    threads cut off by the interpreter's exit print a stray "Exception in thread"."""
-    for node in nodes:
-        for attribute in ("_spin_thread", "_wake_thread"):  # simple_node's, where it is used
-            thread = getattr(node, attribute, None)
-            if isinstance(thread, threading.Thread) and thread is not threading.current_thread():
-                thread.join(timeout)
 
 
 class StopRequest:

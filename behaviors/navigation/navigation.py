@@ -1,4 +1,5 @@
-"""navigation(?origin ?destination - wp): MERLIN2's navigation, telling perception what to expect.
+"""navigation(?o ?d - wp): MERLIN2's navigation (from o, the origin, to d, the destination), telling
+perception what to expect.
 
 1. PLANNING_ROUTE: the destination's pose from the map (its heading, else the way the robot
    arrives), and, before leaving, the objects the knowledge base places there.
@@ -16,7 +17,7 @@ from __future__ import annotations
 
 from merlin2_sailor.errors import KnowledgeError
 from merlin2_sailor_behaviors.actions.context import BehaviorContext
-from merlin2_sailor_behaviors.actions.domain import NAVIGATION, WP_TYPE, predicates_of
+from merlin2_sailor_behaviors.actions.domain import NAVIGATION, NAVIGATION_DESTINATION, WP_TYPE, predicates_of
 from merlin2_sailor_behaviors.actions.errors import BehaviorError
 from merlin2_sailor_behaviors.actions.robot_location import objects_at
 from merlin2_sailor_behaviors.actions.sailor_action import SailorAction
@@ -41,7 +42,7 @@ EXPECTED_KEY = "navigation.expected_objects"
 
 
 def plan_route(state: BehaviorState, blackboard: Blackboard) -> str:
-    destination = blackboard["destination"]
+    destination = blackboard[NAVIGATION_DESTINATION]
     blackboard[TARGET_KEY] = place_target(state.context, destination)
     try:
         blackboard[EXPECTED_KEY] = objects_at(state.context.store, destination)
@@ -53,7 +54,7 @@ def plan_route(state: BehaviorState, blackboard: Blackboard) -> str:
 
 def announce_expected(state: BehaviorState, blackboard: Blackboard) -> str:
     """EXPECT_AT, at their anchors' positions, for the objects the knowledge base put here."""
-    destination = blackboard["destination"]
+    destination = blackboard[NAVIGATION_DESTINATION]
     symbols = blackboard[EXPECTED_KEY]
     if not symbols:
         return SUCCEED  # nothing to check: done
@@ -76,7 +77,7 @@ def announce_expected(state: BehaviorState, blackboard: Blackboard) -> str:
 
 
 def navigation_state_machine(context: BehaviorContext) -> StateMachine:
-    """The navigation behaviour: reads ``destination`` from the blackboard."""
+    """The navigation behaviour: reads the destination (``d``) from the blackboard."""
     machine = StateMachine(outcomes=[SUCCEED, ABORT, CANCEL])
     machine.add_state("PLANNING_ROUTE", CallbackState(context, plan_route), {SUCCEED: "NAVIGATING"})
     machine.add_state("NAVIGATING", GoTo(context, TARGET_KEY), {SUCCEED: "ANNOUNCING"})

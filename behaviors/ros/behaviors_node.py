@@ -79,6 +79,10 @@ class BehaviorsNode(Node):
             self, "anchoring", "/anchoring", "Fully qualified name of the anchoring node whose services are used.")
         navigation_action = declare_parameter(
             self, "navigation_action", "navigate_to_pose", "NavigateToPose action server to drive with.")
+        waypoint_action = declare_parameter(
+            self, "waypoint_navigation_action", "",
+            "NavigateToWp action server (MERLIN2's waypoint navigation) to drive to the map's waypoints by name; "
+            "empty: drive to them with NavigateToPose.")
         robot_pose_topic = declare_parameter(
             self, "robot_pose_topic", "robot_pose", "PoseStamped topic with the robot's pose on the map.")
         frame_id = declare_parameter(self, "frame_id", "map", "Frame of navigation goals (the map).")
@@ -116,7 +120,8 @@ class BehaviorsNode(Node):
         group = ReentrantCallbackGroup()
         caller = ServiceCaller(self, service_timeout, self._stopping, group)
         self._navigation = RosNavigationClient(
-            self, self._stopping, navigation_action, robot_pose_topic, frame_id, server_timeout, goal_timeout, group)
+            self, self._stopping, navigation_action, robot_pose_topic, frame_id, server_timeout, goal_timeout, group,
+            waypoint_action)
         context = BehaviorContext(
             store=self._store,
             anchoring=RosAnchoringClient(caller, anchoring),

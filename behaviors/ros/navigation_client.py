@@ -1,4 +1,5 @@
-"""NavigateToPose (Nav2's, or the simulated world's) and the robot's pose, as a
+"""NavigateToPose (Nav2's where nav2_msgs is installed, else the project's subset, as
+:mod:`merlin2_sailor.ros.navigation_interface` decides) and the robot's pose, as a
 :class:`~merlin2_sailor_behaviors.actions.clients.NavigationPort`.
 
 One goal at a time from the calling (worker) thread; cancelling the behaviour cancels the goal on
@@ -18,19 +19,26 @@ from geometry_msgs.msg import PoseStamped
 from rclpy.callback_groups import CallbackGroup
 from rclpy.node import Node
 
+from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.ros.action_client import RaceFreeActionClient
+from merlin2_sailor.ros.navigation_interface import (
+    navigate_to_pose_type,
+    navigation_interface_name,
+    waypoint_navigation_type,
+)
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_behaviors.actions.clients import NavigationResult, NavigationStatus, Pose2D
 from merlin2_sailor_behaviors.actions.errors import BehaviorError
 from merlin2_sailor_behaviors.ros.conversions import planar_pose, pose_stamped
 from merlin2_sailor_behaviors.ros.waiting import WaitEnd, wait_for, wait_for_future, wait_for_goal_result
-from merlin2_sailor_interfaces.action import NavigateToPose
 
 STOPPING = NavigationResult(NavigationStatus.FAILED, "the behaviors node is shutting down")
 
 
 class RosNavigationClient:
-    """Sends NavigateToPose goals to ``action_name`` and follows ``robot_pose_topic``."""
+    """Sends NavigateToPose goals to ``action_name`` and follows ``robot_pose_topic``; with a
+    ``waypoint_action``, goals that are waypoints of the map go to that NavigateToWp server by name
+    (MERLIN2's waypoint navigation, which drives with the robot's own waypoint poses)."""
 
     def __init__(
         self,
@@ -42,15 +50,32 @@ class RosNavigationClient:
         server_timeout: float = 5.0,
         goal_timeout: float = 300.0,
         callback_group: CallbackGroup | None = None,
+        waypoint_action: str = "",
     ) -> None:
         self._node = node
         self._stopping = stopping
         self._frame_id = frame_id
         self._server_timeout = server_timeout
         self._goal_timeout = goal_timeout
-        self._client = RaceFreeActionClient(node, NavigateToPose, action_name, callback_group=callback_group)
+        self._type = navigate_to_pose_type()
+        self._client = RaceFreeActionClient(node, self._type, action_name, callback_group=callback_group)
         namespace = node.get_namespace().rstrip("/")
         self._action_name = action_name if action_name.startswith("/") else f"{namespace}/{action_name}"
+        self._waypoint_client: RaceFreeActionClient | None = None
+        self._waypoint_action = waypoint_action
+        if waypoint_action:
+            waypoint_type = waypoint_navigation_type()
+            if waypoint_type is None:
+                raise ConfigurationError(
+                    f"waypoint navigation at {waypoint_action!r} needs MERLIN2's waypoint_navigation_msgs, which "
+                    "is not installed; build it in the workspace, or leave the waypoint navigation action empty "
+                    "to drive to waypoints with NavigateToPose")
+            self._waypoint_type = waypoint_type
+            self._waypoint_client = RaceFreeActionClient(
+                node, waypoint_type, waypoint_action, callback_group=callback_group)
+        node.get_logger().info(
+            f"driving with {navigation_interface_name()} at {self._action_name}"
+            + (f"; to the map's waypoints by name with NavigateToWp at {waypoint_action}" if waypoint_action else ""))
         self._pose: Pose2D | None = None
         self._pose_lock = threading.Lock()
         node.create_subscription(PoseStamped, robot_pose_topic, self._on_pose, SENSOR_DATA,
@@ -74,30 +99,42 @@ class RosNavigationClient:
         with self._pose_lock:
             self._pose = pose
 
-    def navigate(self, goal: Pose2D, should_cancel: Callable[[], bool]) -> NavigationResult:
-        end = wait_for(self._client.server_is_ready, self._server_timeout, self._stopping, should_cancel)
+    def navigate(self, goal: Pose2D, should_cancel: Callable[[], bool], waypoint: str = "") -> NavigationResult:
+        if waypoint and self._waypoint_client is not None:
+            request = self._waypoint_type.Goal(wp_id=waypoint)
+            return self._run_goal(self._waypoint_client, self._waypoint_action, request, should_cancel,
+                                  f"waypoint {waypoint!r}")
+        request = self._type.Goal(pose=pose_stamped(goal, self._frame_id))
+        request.pose.header.stamp = self._node.get_clock().now().to_msg()
+        return self._run_goal(self._client, self._action_name, request, should_cancel, "the pose")
+
+    def _run_goal(
+        self, client: RaceFreeActionClient, action_name: str, request: object, should_cancel: Callable[[], bool],
+        destination: str,
+    ) -> NavigationResult:
+        """One goal, sent and waited for, every wait with its deadline."""
+        end = wait_for(client.server_is_ready, self._server_timeout, self._stopping, should_cancel)
         if end is WaitEnd.CANCELED:
             return NavigationResult(NavigationStatus.CANCELED)
         if end is WaitEnd.STOPPING:
             return STOPPING
         if end is WaitEnd.TIMEOUT:
             raise BehaviorError(
-                f"no NavigateToPose server at {self.action_name} after {self._server_timeout:g} s; "
-                "is the navigation (Nav2 or the simulated world) running?"
+                f"no {type(request).__name__.removesuffix('_Goal')} server at {action_name} after "
+                f"{self._server_timeout:g} s; is the navigation (Nav2, MERLIN2's waypoint navigation or the "
+                "simulated world) running?"
             )
-        request = NavigateToPose.Goal(pose=pose_stamped(goal, self._frame_id))
-        request.pose.header.stamp = self._node.get_clock().now().to_msg()
-        sent = self._client.send_goal_async(request)
+        sent = client.send_goal_async(request)
         end = wait_for_future(sent, self._server_timeout, self._stopping)
         if end is WaitEnd.STOPPING:
             return STOPPING
         if end is not WaitEnd.DONE or sent.result() is None:
-            raise BehaviorError(f"{self.action_name} did not answer a goal within {self._server_timeout:g} s")
+            raise BehaviorError(f"{action_name} did not answer a goal within {self._server_timeout:g} s")
         handle = sent.result()
         if not handle.accepted:
-            return NavigationResult(NavigationStatus.FAILED, f"{self.action_name} rejected the goal")
+            return NavigationResult(NavigationStatus.FAILED, f"{action_name} rejected the goal to {destination}")
         waited = wait_for_goal_result(handle, self._goal_timeout, self._stopping, should_cancel)
-        self._report_requeries(waited.requeries)
+        self._report_requeries(action_name, waited.requeries)
         if waited.end is not WaitEnd.DONE:
             handle.cancel_goal_async()
             if waited.end is WaitEnd.STOPPING:
@@ -106,26 +143,37 @@ class RosNavigationClient:
                 return NavigationResult(
                     NavigationStatus.FAILED, f"the robot did not arrive within {self._goal_timeout:g} s")
             # Cancelled: give the server a moment to stop the robot and say so.
-            self._report_requeries(wait_for_goal_result(handle, self._server_timeout, self._stopping).requeries)
+            cancelled = wait_for_goal_result(handle, self._server_timeout, self._stopping)
+            self._report_requeries(action_name, cancelled.requeries)
             return NavigationResult(NavigationStatus.CANCELED)
-        return self._outcome(waited.response, should_cancel)
+        return self._outcome(action_name, destination, waited.response, should_cancel)
 
-    def _report_requeries(self, requeries: int) -> None:
+    def _report_requeries(self, action_name: str, requeries: int) -> None:
         if requeries:
             self._node.get_logger().warning(
-                f"a result of {self.action_name} was lost on the way; asked for it again ({requeries} time(s))")
+                f"a result of {action_name} was lost on the way; asked for it again ({requeries} time(s))")
 
-    def _outcome(self, response: object, should_cancel: Callable[[], bool]) -> NavigationResult:
+    def _outcome(
+        self, action_name: str, destination: str, response: object, should_cancel: Callable[[], bool],
+    ) -> NavigationResult:
         status = getattr(response, "status", GoalStatus.STATUS_UNKNOWN)
         if status == GoalStatus.STATUS_SUCCEEDED:
             return NavigationResult(NavigationStatus.ARRIVED)
         if status == GoalStatus.STATUS_CANCELED and should_cancel():
             return NavigationResult(NavigationStatus.CANCELED)
         result = getattr(response, "result", None)
-        code = getattr(result, "error_code", 0)
-        text = getattr(result, "error_msg", "") or "no reason given"
         how = {GoalStatus.STATUS_ABORTED: "aborted", GoalStatus.STATUS_CANCELED: "cancelled"}.get(status, "ended")
-        return NavigationResult(NavigationStatus.FAILED, f"{self.action_name} {how} the goal (error {code}: {text})")
+        if not hasattr(result, "error_code"):  # NavigateToWp's result says nothing
+            return NavigationResult(
+                NavigationStatus.FAILED,
+                f"{action_name} {how} the goal to {destination} (it gives no reason: an unknown waypoint, or its "
+                "NavigateToPose failed)")
+        text = getattr(result, "error_msg", "") or "no reason given"
+        return NavigationResult(
+            NavigationStatus.FAILED,
+            f"{action_name} {how} the goal to {destination} (error {result.error_code}: {text})")
 
     def destroy(self) -> None:
         self._client.destroy()
+        if self._waypoint_client is not None:
+            self._waypoint_client.destroy()

@@ -35,8 +35,10 @@ class ServiceCaller:
         with self._lock:
             client = self._clients.get(name)
             if client is None:
-                client = self._clients[name] = self._node.create_client(
-                    service_type, name, callback_group=self._group)
+                # rclpy's own method: subclasses may narrow it (simple_node's, under every MERLIN2
+                # node, takes no callback group).
+                client = self._clients[name] = Node.create_client(
+                    self._node, service_type, name, callback_group=self._group)
         end = wait_for(client.service_is_ready, self._timeout, self._stopping)
         if end is WaitEnd.STOPPING:
             raise BehaviorError("the behaviors node is shutting down")

@@ -38,8 +38,8 @@ class StandInRobot:
         from rclpy.callback_groups import ReentrantCallbackGroup
         from rclpy.executors import MultiThreadedExecutor
 
+        from merlin2_sailor.ros.navigation_interface import navigate_to_pose_type
         from merlin2_sailor_interfaces import srv
-        from merlin2_sailor_interfaces.action import NavigateToPose
 
         self.context = rclpy.Context()
         rclpy.init(context=self.context)
@@ -53,7 +53,7 @@ class StandInRobot:
         self.pose = (0.1, 0.0)
         self._pose_type = PoseStamped
         self._navigation = ActionServer(
-            self.node, NavigateToPose, f"{prefix}/navigate_to_pose", self._navigate,
+            self.node, navigate_to_pose_type(), f"{prefix}/navigate_to_pose", self._navigate,
             cancel_callback=lambda goal: CancelResponse.ACCEPT, callback_group=group)
         self._pose_publisher = self.node.create_publisher(PoseStamped, f"{prefix}/robot_pose", 10)
         self.node.create_timer(0.1, self._publish_pose, callback_group=group)
@@ -82,7 +82,9 @@ class StandInRobot:
         self._pose_publisher.publish(message)
 
     def _navigate(self, goal_handle):  # noqa: ANN001, ANN202 - rclpy callback
-        from merlin2_sailor_interfaces.action import NavigateToPose
+        from merlin2_sailor.ros.navigation_interface import NavigationErrorCode, navigate_to_pose_type
+
+        NavigateToPose = navigate_to_pose_type()  # noqa: N806 - a message type
 
         pose = goal_handle.request.pose.pose
         yaw = 2.0 * math.atan2(pose.orientation.z, pose.orientation.w)
@@ -95,9 +97,9 @@ class StandInRobot:
             if goal_handle.is_cancel_requested:
                 self.cancelled.set()
                 goal_handle.canceled()
-                return NavigateToPose.Result(error_code=NavigateToPose.Result.CANCELED)
+                return NavigateToPose.Result(error_code=NavigationErrorCode.CANCELED)
             goal_handle.abort()
-            return NavigateToPose.Result(error_code=NavigateToPose.Result.TIMEOUT)
+            return NavigateToPose.Result(error_code=NavigationErrorCode.TIMEOUT)
         self.pose = (pose.position.x, pose.position.y)
         goal_handle.succeed()
         return NavigateToPose.Result()

@@ -51,3 +51,43 @@ def test_ctrl_c_withdraws_every_action_once_and_exits_0(start_kant_node, ros_pro
     assert "context is invalid" not in output, output
     assert registered_actions(kant.location) == {}, output
     assert kant.process.poll() is None
+
+
+def registered_action(location: str, name: str):  # noqa: ANN201 - a PddlAction or None
+    with open_store(location) as kant:
+        return kant.actions.get(name)
+
+
+def test_sailors_navigation_is_merlin2s_navigation_as_kant_holds_it(start_kant_node, ros_probe) -> None:
+    """SAILOR's navigation can stand in for merlin2_basic_actions': the same PDDL action in KANT."""
+    kant = start_kant_node("/merlin2")
+    merlin2 = subprocess.Popen(
+        [sys.executable, "-m", "merlin2_basic_actions.merlin2_navigation_fsm_action"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
+    try:
+        assert ros_probe.wait_for(lambda: registered_action(kant.location, "navigation") is not None,
+                                  timeout=START_SECONDS), "MERLIN2's navigation never appeared in KANT"
+        merlin2_navigation = registered_action(kant.location, "navigation")
+    finally:
+        merlin2.send_signal(signal.SIGINT)
+        merlin2.wait(timeout=30)
+    with open_store(kant.location) as store:  # MERLIN2's action may outlive its process
+        store.actions.delete("navigation")
+    sailor = subprocess.Popen(
+        [sys.executable, "-m", "merlin2_sailor_behaviors.merlin2.run", "navigation"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, text=True)
+    try:
+        assert ros_probe.wait_for(lambda: registered_action(kant.location, "navigation") is not None,
+                                  timeout=START_SECONDS), "SAILOR's navigation never appeared in KANT"
+        sailor_navigation = registered_action(kant.location, "navigation")
+    finally:
+        sailor.send_signal(signal.SIGINT)
+        output, _ = sailor.communicate(timeout=30)
+    assert sailor.returncode == 0, output
+    # The same action: effects compared as a set (MERLIN2 lists the at-end effect first).
+    def signature(action):  # noqa: ANN001, ANN202
+        return (action.name, action.parameters, set(action.conditions), set(action.effects), action.durative,
+                action.duration)
+
+    assert signature(sailor_navigation) == signature(merlin2_navigation)
+    assert [(p.name, p.type) for p in sailor_navigation.parameters] == [("o", "wp"), ("d", "wp")]

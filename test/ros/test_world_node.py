@@ -13,9 +13,9 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from merlin2_sailor.resources import config_file
 from merlin2_sailor.ros.conversions import depth_to_metres, detections_from_message, image_to_array
+from merlin2_sailor.ros.navigation_interface import NavigationErrorCode, navigate_to_pose_type
 from merlin2_sailor.ros.qos import SENSOR_DATA
 from merlin2_sailor_demos.world import load_world
-from merlin2_sailor_interfaces.action import NavigateToPose
 from merlin2_sailor_interfaces.msg import DetectionArray
 from merlin2_sailor_interfaces.srv import Grasp
 
@@ -87,7 +87,8 @@ def test_frames_navigation_and_grasp(ros_probe, node_process, tmp_path) -> None:
                                                                   target=_point(2.1, 2.1))), 10.0)
         assert picked.success and picked.object_id == "red_mug", picked.message
 
-        # Drive to the living room with it.
+        # Drive to the living room with it, through Nav2's type where nav2_msgs is built.
+        NavigateToPose = navigate_to_pose_type()  # noqa: N806 - a message type
         client = ActionClient(ros_probe.node, NavigateToPose, f"{NAMESPACE}/navigate_to_pose")
         assert client.wait_for_server(timeout_sec=20.0)
         target = house.waypoint("living_room").pose
@@ -99,7 +100,7 @@ def test_frames_navigation_and_grasp(ros_probe, node_process, tmp_path) -> None:
         handle = _wait(ros_probe, client.send_goal_async(goal, feedback_callback=feedback.append), 10.0)
         assert handle.accepted
         result = _wait(ros_probe, handle.get_result_async(), 25.0).result
-        assert result.error_code == NavigateToPose.Result.NONE, result.error_msg
+        assert result.error_code == NavigationErrorCode.NONE, result.error_msg
         assert feedback and feedback[0].feedback.distance_remaining > 1.0
         (pose,) = ros_probe.collect(PoseStamped, f"{NAMESPACE}/robot_pose", 1, SENSOR_DATA)
         assert math.hypot(pose.pose.position.x - target.x, pose.pose.position.y - target.y) < 0.1
@@ -107,7 +108,7 @@ def test_frames_navigation_and_grasp(ros_probe, node_process, tmp_path) -> None:
         # A goal outside the house fails cleanly; then put the mug down ahead of the robot.
         goal.pose.pose.position.x = 50.0
         bad = _wait(ros_probe, _wait(ros_probe, client.send_goal_async(goal), 10.0).get_result_async(), 10.0)
-        assert bad.result.error_code == NavigateToPose.Result.UNKNOWN and "outside the house" in bad.result.error_msg
+        assert bad.result.error_code == NavigationErrorCode.UNKNOWN and "outside the house" in bad.result.error_msg
         placed = _wait(ros_probe, grasp.call_async(Grasp.Request(operation=Grasp.Request.PLACE,
                                                                   target=_point(math.nan, math.nan))), 10.0)
         assert placed.success, placed.message
@@ -119,7 +120,7 @@ def test_frames_navigation_and_grasp(ros_probe, node_process, tmp_path) -> None:
         ros_probe.wait_for(lambda: False, timeout=1.0)
         _wait(ros_probe, handle.cancel_goal_async(), 10.0)
         cancelled = _wait(ros_probe, handle.get_result_async(), 10.0).result
-        assert cancelled.error_code == NavigateToPose.Result.CANCELED
+        assert cancelled.error_code == NavigationErrorCode.CANCELED
         client.destroy()
     finally:
         assert process.stop() == 0, process.text

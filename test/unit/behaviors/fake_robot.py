@@ -57,14 +57,17 @@ class FakeNavigation:
     def __init__(self, pose: Pose2D | None = START_POSE) -> None:
         self.pose = pose
         self.goals: list[Pose2D] = []
+        self.waypoints: list[str] = []
+        """The waypoint each goal named ("" when the goal was no waypoint)."""
         self.unreachable: set[tuple[float, float]] = set()
         self.block = False
         self.started = threading.Event()
         self.cancelled = threading.Event()
         self.on_arrival: list[Callable[[Pose2D], None]] = []
 
-    def navigate(self, goal: Pose2D, should_cancel: Callable[[], bool]) -> NavigationResult:
+    def navigate(self, goal: Pose2D, should_cancel: Callable[[], bool], waypoint: str = "") -> NavigationResult:
         self.goals.append(goal)
+        self.waypoints.append(waypoint)
         self.started.set()
         if self.block:
             for _ in range(500):

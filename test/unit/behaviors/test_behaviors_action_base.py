@@ -35,7 +35,7 @@ def store() -> Iterator[KnowledgeBase]:
 def test_the_catalogue_serves_the_whole_domain_under_its_pddl_names() -> None:
     assert list(SAILOR_ACTIONS) == ["navigation", "explore", "approach_object", "find_object", "bring"]
     assert {name: action.pddl for name, action in SAILOR_ACTIONS.items()} == dict(ACTIONS)
-    assert SAILOR_ACTIONS["navigation"].parameter_names == ("origin", "destination")
+    assert SAILOR_ACTIONS["navigation"].parameter_names == ("o", "d")  # MERLIN2's names
     assert [a.name for a in select_actions(["bring", "navigation"])] == ["bring", "navigation"]
     with pytest.raises(ConfigurationError, match="unknown action"):
         select_actions(["fly"])

@@ -162,9 +162,9 @@ def test_without_merlin2_the_adapter_says_what_to_install(monkeypatch: pytest.Mo
 
 def test_the_pddl_action_becomes_kant_dtos_saved_after_its_types_and_predicates(merlin2, robot: FakeRobot) -> None:
     node = merlin2(SAILOR_ACTIONS["navigation"], lambda node, stopping: robot.context)
-    assert [(p.get_name(), p.type.get_name()) for p in node.parameters] == [("origin", "wp"), ("destination", "wp")]
-    assert [c.text() for c in node.conditions] == ["at start: robot_at(origin)"]
-    assert [e.text() for e in node.effects] == ["at start: not robot_at(origin)", "at end: robot_at(destination)"]
+    assert [(p.get_name(), p.type.get_name()) for p in node.parameters] == [("o", "wp"), ("d", "wp")]
+    assert [c.text() for c in node.conditions] == ["at start: robot_at(o)"]
+    assert [e.text() for e in node.effects] == ["at start: not robot_at(o)", "at end: robot_at(d)"]
     saved = [type(dto).__name__ + ":" + dto.get_name() for dto in node.dao_factory.saved]
     assert saved == ["PddlTypeDto:wp", "PddlPredicateDto:robot_at", "SailorMerlin2FsmAction:navigation"]
 
@@ -180,7 +180,7 @@ def test_run_action_puts_the_goal_objects_under_the_parameter_names_and_runs_the
 ) -> None:
     node = merlin2(SAILOR_ACTIONS["navigation"], lambda node, stopping: robot.context)
     assert node.run_action(PlanAction("navigation", ["a", "b"]))
-    assert node.last_blackboard["destination"] == "b"
+    assert node.last_blackboard["d"] == "b"
     assert (robot.navigation.goals[0].x, robot.navigation.goals[0].y) == (2.0, 0.0)
     assert not node.run_action(PlanAction("navigation", ["a"]))  # wrong arity: aborted, not a crash
 

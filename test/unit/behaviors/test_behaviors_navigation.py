@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import threading
 
@@ -9,6 +10,7 @@ import pytest
 
 from merlin2_sailor.knowledge import PddlObject, Proposition, Provenance
 from merlin2_sailor_behaviors.actions import REASON_KEY, WARNINGS_KEY, BehaviorConfig, Pose2D
+from merlin2_sailor_behaviors.actions.places import Place, Places
 from merlin2_sailor_behaviors.navigation import (
     APPROACH_OBJECT_ACTION,
     EXPLORE_ACTION,
@@ -166,3 +168,19 @@ def test_approach_aborts_when_the_object_is_not_seen_in_time(robot: FakeRobot) -
 def test_approach_of_an_object_nobody_anchored_aborts(robot: FakeRobot) -> None:
     outcome, blackboard = run(robot, APPROACH_OBJECT_ACTION, "cup_9", "b")
     assert outcome == ABORT and "no anchor 'cup_9'" in blackboard[REASON_KEY]
+
+
+def test_a_waypoint_is_named_to_the_navigation_and_a_region_or_a_turn_is_not(robot: FakeRobot) -> None:
+    """A robot with a waypoint navigation (MERLIN2's NavigateToWp) drives to waypoints by name; a
+    region's centre and the turns of a look-around are poses it has no name for."""
+    put(robot, "cup_1", "b", (2.3, 0.2, 0.8))  # so the navigation looks around on arrival
+    assert run(robot, NAVIGATION_ACTION, "a", "b")[0] == SUCCEED
+    assert robot.navigation.waypoints[0] == "b"
+    assert set(robot.navigation.waypoints[1:]) == {""} and len(robot.navigation.waypoints) > 1
+
+    places = Places([*(robot.context.places.get(name) for name in robot.context.places.names()),
+                     Place("b_area", 2.0, 1.0, is_waypoint=False)])
+    region_robot = dataclasses.replace(robot, context=dataclasses.replace(robot.context, places=places))
+    assert run(region_robot, NAVIGATION_ACTION, "b", "b_area")[0] == SUCCEED
+    assert robot.navigation.waypoints[-1] == ""
+    assert (robot.navigation.goals[-1].x, robot.navigation.goals[-1].y) == (2.0, 1.0)
