@@ -43,6 +43,11 @@ interfaces=(
   waypoint_navigation/waypoint_navigation_msgs
   text_to_speech/text_to_speech_msgs
   speech_to_text/speech_to_text_msgs
+  vision_msgs/vision_msgs
+  yolo_ros/yolo_msgs
+  geometry2/tf2_msgs
+  geometry2/tf2
+  geometry2/tf2_py
 )
 # Interface packages of which only part builds here: name, then the interface files generated
 # (Nav2's nav2_msgs also needs geographic_msgs, which the ROS 2 wheels lack; NavigateToPose does not).
@@ -52,6 +57,8 @@ subset_files=(action/NavigateToPose.action)
 subset_depends=(std_msgs builtin_interfaces geometry_msgs action_msgs)
 # Projects whose Python packages go on the path as they are in the checkout.
 python_projects=(kant yasmin simple_node merlin2 waypoint_navigation)
+# Python packages whose folder is not named after them (tf2_ros_py holds tf2_ros).
+python_roots=(geometry2/tf2_ros_py)
 
 for package in "${interfaces[@]}" "$subset_source"; do
   [ -f "$upstream/$package/package.xml" ] || die "$upstream/$package is missing; SAILOR_UPSTREAM must \
@@ -140,6 +147,10 @@ for project in "${python_projects[@]}"; do
   done < <(find "$upstream/$project" -name package.xml | sort)
 done
 
+for root in "${python_roots[@]}"; do
+  [ -d "$upstream/$root" ] || die "$upstream/$root is missing"
+  python_paths+=("$upstream/$root")
+done
 joined_paths="$(IFS=:; echo "${python_paths[*]}")"
 cat > "$env_file" <<EOF
 # Written by scripts/upstream_env.sh from SAILOR_UPSTREAM=$upstream; source it.

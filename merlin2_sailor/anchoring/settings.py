@@ -85,15 +85,32 @@ class TimingSettings:
             raise ConfigurationError(f"timing stamp_tolerance must be >= 0 seconds, got {self.stamp_tolerance}.")
 
 
+POSE_SOURCES = ("topic", "tf")
+
+
+@dataclass(frozen=True, slots=True)
+class InputSettings:
+    """Where the node takes the camera pose from: ``pose_source`` ``topic`` (PoseStamped on
+    camera_pose) or ``tf`` (TF, the camera info's optical frame in the world frame at each stamp)."""
+
+    pose_source: str = "topic"
+
+    def __post_init__(self) -> None:
+        if self.pose_source not in POSE_SOURCES:
+            raise ConfigurationError(f"inputs pose_source must be one of {', '.join(POSE_SOURCES)}, "
+                                     f"got '{self.pose_source}'.")
+
+
 @dataclass(frozen=True, slots=True)
 class AnchoringSettings:
     """Everything the anchoring service is built from: the ``core`` (:class:`AnchoringConfig`), the
-    ``matcher``, the ``persistence`` and the node's ``timing``."""
+    ``matcher``, the ``persistence``, the node's ``timing`` and its camera ``inputs``."""
 
     core: AnchoringConfig = field(default_factory=AnchoringConfig)
     matcher: MatcherSettings = field(default_factory=MatcherSettings)
     persistence: PersistenceSettings = field(default_factory=PersistenceSettings)
     timing: TimingSettings = field(default_factory=TimingSettings)
+    inputs: InputSettings = field(default_factory=InputSettings)
 
 
 @cache
@@ -374,6 +391,10 @@ SETTINGS: tuple[Setting, ...] = (
         Setting("stamp_tolerance", ("timing", "stamp_tolerance"),
                 "Largest gap (s) between the percepts and the camera pose / depth image they are judged "
                 "with; without a pose that close, no anchor is marked missing that frame.", 0.0, 1.0),
+        Setting("pose_source", ("inputs", "pose_source"),
+                "Camera pose from topic (PoseStamped on camera_pose, the optical frame in world_frame) or from "
+                "tf (TF through tf2_ros: the camera info's frame in world_frame at each percept stamp; a frame "
+                "without that transform is dropped, counted and logged).", choices=POSE_SOURCES),
     ),
 )
 
@@ -533,10 +554,10 @@ _FILE_HEADER = """\
 # Every value here is the default of merlin2_sailor/anchoring/settings.py's table, which also gives
 # each its range; `python -m merlin2_sailor.anchoring.settings` prints this file from it.
 # Topics in: percepts (PerceptArray), color/camera_info, camera_pose (PoseStamped, optical frame in
-# world_frame), depth/image_raw (optional, enables the occlusion test), robot_pose (PoseStamped,
-# for carried objects). Out: anchors (AnchorArray, latched), anchor_events (AnchorEventArray),
-# anchor_markers (MarkerArray). Services: ~/get_anchors, ~/find_anchor, ~/forget_anchor,
-# ~/expect_anchor.
+# world_frame; or /tf and /tf_static with pose_source tf), depth/image_raw (optional, enables the
+# occlusion test), robot_pose (PoseStamped, for carried objects). Out: anchors (AnchorArray,
+# latched), anchor_events (AnchorEventArray), anchor_markers (MarkerArray). Services:
+# ~/get_anchors, ~/find_anchor, ~/forget_anchor, ~/expect_anchor.
 """
 
 

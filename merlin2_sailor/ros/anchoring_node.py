@@ -55,6 +55,7 @@ from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
 from merlin2_sailor.ros.stores import open_store
+from merlin2_sailor.ros.tf_poses import TfCameraPoses
 from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import AnchorArray, AnchorEventArray, PerceptArray
 
@@ -105,7 +106,12 @@ class AnchoringNode(Node):
         self._markers_publisher = self.create_publisher(MarkerArray, "anchor_markers", LATCHED)
         self.create_subscription(PerceptArray, "percepts", self._on_percepts, SENSOR_DATA)
         self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, SENSOR_DATA)
-        self.create_subscription(PoseStamped, "camera_pose", self._on_camera_pose, SENSOR_DATA)
+        self._tf_poses: TfCameraPoses | None = None
+        self._camera_frame = ""
+        if settings.inputs.pose_source == "tf":
+            self._tf_poses = TfCameraPoses(self, self._world_frame, alternative="pose_source 'topic', camera_pose")
+        else:
+            self.create_subscription(PoseStamped, "camera_pose", self._on_camera_pose, SENSOR_DATA)
         self.create_subscription(Image, "depth/image_raw", self._on_depth, SENSOR_DATA)
         self.create_subscription(PoseStamped, "robot_pose", self._on_robot_pose, SENSOR_DATA)
         self.create_service(srv.GetAnchors, "~/get_anchors", self._get_anchors)
@@ -151,6 +157,7 @@ class AnchoringNode(Node):
     def _on_camera_info(self, message: CameraInfo) -> None:
         try:
             self._intrinsics = camera_info_to_intrinsics(message)
+            self._camera_frame = message.header.frame_id  # the optical frame, for TF
         except SailorError as error:
             self.get_logger().warning(f"dropped camera info: {error}", throttle_duration_sec=5.0)
 
@@ -198,7 +205,7 @@ class AnchoringNode(Node):
             self._refuse_future_stamps(stamp, message)
             percepts = percepts_from_message(message)
             with self._lock:
-                result = self._anchoring.process(percepts, self._camera_view(stamp), stamp)
+                result = self._anchoring.process(percepts, self._camera_view(stamp, message.header.stamp), stamp)
         except SailorError as error:
             self.get_logger().warning(f"dropped {len(message.percepts)} percepts: {error}",
                                       throttle_duration_sec=5.0)
@@ -213,9 +220,18 @@ class AnchoringNode(Node):
                 f"stamped {lead:.0f} s ahead of this node's clock (more than {FUTURE_STAMP_LIMIT_SECONDS:g} s); "
                 "synchronise the clocks of the camera and this computer")
 
-    def _camera_view(self, stamp: float) -> CameraView | None:
-        """The camera as it was at ``stamp``; without it no anchor is judged missing."""
-        pose = self._poses.nearest(stamp)
+    def _camera_view(self, stamp: float, stamp_message: Any) -> CameraView | None:
+        """The camera as it was at ``stamp``; without it no anchor is judged missing.
+
+        Raises:
+            InvalidInputError: with TF, no transform for the camera at that stamp (the frame is dropped).
+        """
+        if self._tf_poses is not None:
+            if self._intrinsics is None:
+                return None
+            pose = self._tf_poses.lookup(self._camera_frame, stamp_message)
+        else:
+            pose = self._poses.nearest(stamp)
         if self._intrinsics is None or pose is None:
             return None
         depth = self._depths.nearest(stamp)

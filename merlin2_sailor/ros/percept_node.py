@@ -38,7 +38,6 @@ from builtin_interfaces.msg import Time as TimeMessage
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
-from rclpy.time import Time
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
@@ -46,7 +45,7 @@ from visualization_msgs.msg import MarkerArray
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.diagnostics.topic_statistics import TopicStatistics
-from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidInputError
+from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.box3d import Box3DConfig, RejectionReason
 from merlin2_sailor.perception.detection import Detection
 from merlin2_sailor.perception.percept_generator import PerceptBatch, PerceptGenerator, PerceptGeneratorConfig
@@ -55,7 +54,6 @@ from merlin2_sailor.perception.tracker import ByteTrackAdapter, ByteTrackConfig
 from merlin2_sailor.ros.conversions import (
     camera_info_to_intrinsics,
     depth_to_metres,
-    detections_from_message,
     image_to_array,
     image_to_rgb,
     odometry_to_camera_pose,
@@ -64,13 +62,21 @@ from merlin2_sailor.ros.conversions import (
     point_cloud_to_array,
     pose_from_message,
     stamp_to_seconds,
-    transform_to_pose,
+)
+from merlin2_sailor.ros.conversions.detection_sources import (
+    DETECTION_TYPES,
+    NUMERIC_CLASS_IDS,
+    detection_source,
+)
+from merlin2_sailor.ros.conversions.detection_sources import (
+    SAILOR as SAILOR_DETECTIONS,
 )
 from merlin2_sailor.ros.newest_frame_mailbox import NewestFrameMailbox
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import SENSOR_DATA
-from merlin2_sailor_interfaces.msg import DetectionArray, PerceptArray
+from merlin2_sailor.ros.tf_poses import TfCameraPoses
+from merlin2_sailor_interfaces.msg import PerceptArray
 
 NODE_NAME = "percept_generator"
 WARNING_PERIOD_SECONDS = 5.0  # bad input is logged at most this often, whatever the camera rate
@@ -78,9 +84,6 @@ WARNING_PERIOD_SECONDS = 5.0  # bad input is logged at most this often, whatever
 #: drops everything older than the last set it emitted, so one frame from a clock that jumped
 #: ahead would otherwise silence the node until the real time caught up with it.
 FUTURE_STAMP_LIMIT_SECONDS = 10.0
-#: Masks are rasterised at the size they claim: one claiming more pixels than any camera image is
-#: refused unread (2**31 x 2**31 raised MemoryError and killed the node; less would fill the memory).
-MAXIMUM_MASK_PIXELS = 8192 * 8192
 #: Detection arrays whose stamps estimate the tracker's frame rate when it is not configured.
 RATE_ESTIMATION_FRAMES = 5
 #: The optical frame at the robot base's origin looking forward: REP 103 base (x forward, z up).
@@ -106,6 +109,15 @@ class PerceptNode(Node):
         pose_message = self._choice("pose_message", "PoseStamped", POSE_MESSAGES,
                                     "With pose_source topic: PoseStamped on camera_pose (the optical frame's "
                                     "pose) or Odometry on odom (with camera_extrinsics).")
+        detections_type = self._choice(
+            "detections_type", SAILOR_DETECTIONS, DETECTION_TYPES,
+            "Message type on detections: sailor (merlin2_sailor_interfaces/DetectionArray), yolo_msgs "
+            "(yolo_ros' DetectionArray) or vision_msgs (Detection2DArray).")
+        numeric_class_ids = self._choice(
+            "numeric_class_ids", "coco", NUMERIC_CLASS_IDS,
+            "vision_msgs only: how a class_id that is a number is read: coco (YOLO's 0-79) or coco_tf "
+            "(TensorFlow's 1-90); a class_id that is a name is taken as it is.")
+        self._detections = detection_source(detections_type, numeric_class_ids)
         extrinsics = declare_parameter(
             self, "camera_extrinsics", FORWARD_OPTICAL_EXTRINSICS,
             "Odometry only: pose of the camera optical frame in the robot base frame, [x, y, z, qx, qy, qz, qw].",
@@ -129,8 +141,7 @@ class PerceptNode(Node):
         self._intrinsics: CameraIntrinsics | None = None
         self._camera_info_key: tuple[Any, ...] | None = None
         self._image_frame_id = ""
-        self._tf_buffer: Any = None
-        self._tf_listener: Any = None
+        self._tf_poses: TfCameraPoses | None = None
 
         self._published = TopicStatistics(window_seconds=report_period)
         self._dropped_reasons: Counter[str] = Counter()
@@ -152,12 +163,13 @@ class PerceptNode(Node):
         else:
             self.create_subscription(PointCloud2, "depth/points", self._on_point_cloud, SENSOR_DATA)
         self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, SENSOR_DATA)
-        self.create_subscription(DetectionArray, "detections", self._on_detections, SENSOR_DATA)
+        self.create_subscription(self._detections.message_type, "detections", self._on_detections, SENSOR_DATA)
         self._subscribe_pose(pose_source, pose_message, extrinsics)
         self.create_timer(report_period, self._report)
         self.get_logger().info(
             f"percepts in '{self._world_frame}' from {depth_source}, pose from "
-            f"{pose_message if pose_source == 'topic' else 'tf2'}, tracker {tracker}"
+            f"{pose_message if pose_source == 'topic' else 'tf2'}, tracker {tracker}, detections as "
+            f"{self._detections.type_name}"
         )
 
     # --- parameters -----------------------------------------------------------------------------
@@ -209,7 +221,9 @@ class PerceptNode(Node):
 
     def _subscribe_pose(self, pose_source: str, pose_message: str, extrinsics: Sequence[float]) -> None:
         if pose_source == "tf":
-            self._tf_buffer, self._tf_listener = _make_tf_listener(self)
+            self._tf_poses = TfCameraPoses(
+                self, self._world_frame, alternative="pose_source 'topic': camera_pose as PoseStamped, or odom as "
+                "Odometry with camera_extrinsics")
             return  # poses are looked up when detections arrive, see _on_detections
         if pose_message == "PoseStamped":
             self.create_subscription(PoseStamped, "camera_pose", self._pose_callback(
@@ -268,20 +282,20 @@ class PerceptNode(Node):
 
         return on_pose
 
-    def _on_detections(self, message: DetectionArray) -> None:
+    def _on_detections(self, message: Any) -> None:
         try:
             self._refuse_future_stamp(message.header)  # before the tracker sees the stamp
-            _refuse_oversized_masks(message)
-            detections = detections_from_message(message)
+            detections = self._detections.read(message)
         except InvalidInputError as error:
             self._warn("detections", f"detections dropped: {error}")
             return
         stamp = stamp_to_seconds(message.header.stamp)
         detections = self._track(detections, stamp)
-        if self._tf_buffer is not None:
+        if self._tf_poses is not None:
             # Looked up now rather than when the image arrived: by the time the detector has
             # answered, the transform at the image stamp has reached the tf buffer.
-            self._push("pose", message.header, lambda: self._lookup_camera_pose(message.header))
+            self._push("pose", message.header, lambda: self._tf_poses.lookup(message.header.frame_id,
+                                                                             message.header.stamp))
         self._push("detections", message.header, lambda: detections)
 
     def _push(self, input_name: str, header: Header, convert: Callable[[], Any]) -> None:
@@ -388,21 +402,6 @@ class PerceptNode(Node):
             self._last_warning[key] = now
             self.get_logger().warning(text)
 
-    # --- pose from tf2 ----------------------------------------------------------------------------
-
-    def _lookup_camera_pose(self, header: Header) -> Pose:
-        import tf2_ros  # present: _make_tf_listener checked it
-
-        try:
-            transform = self._tf_buffer.lookup_transform(
-                self._world_frame, header.frame_id, Time.from_msg(header.stamp)
-            )
-        except tf2_ros.TransformException as error:
-            raise InvalidInputError(
-                f"no transform {self._world_frame} <- {header.frame_id} at the image stamp: {error}"
-            ) from error
-        return transform_to_pose(transform)
-
     # --- reporting --------------------------------------------------------------------------------
 
     def _report(self) -> None:
@@ -432,30 +431,6 @@ class PerceptNode(Node):
 
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
-
-
-def _refuse_oversized_masks(message: DetectionArray) -> None:
-    for detection in message.detections:
-        mask = detection.mask
-        if mask.data and mask.height * mask.width > MAXIMUM_MASK_PIXELS:
-            raise InvalidInputError(
-                f"detection '{detection.class_name}' has a mask of {mask.width}x{mask.height} pixels, "
-                f"more than the {MAXIMUM_MASK_PIXELS} of any camera image"
-            )
-
-
-def _make_tf_listener(node: Node) -> tuple[Any, Any]:
-    """A tf2 buffer and the listener on ``node`` that fills it; a clear error where tf2_ros is missing."""
-    try:
-        import tf2_ros
-    except ImportError as error:
-        raise DependencyError(
-            "pose_source 'tf' needs tf2_ros, which is not installable from PyPI (no wheel exists); run under a "
-            "ROS 2 Jazzy installation (apt or source), or set pose_source to 'topic' and publish the camera "
-            "pose as PoseStamped (camera_pose) or Odometry (odom) with camera_extrinsics"
-        ) from error
-    buffer = tf2_ros.Buffer()
-    return buffer, tf2_ros.TransformListener(buffer, node)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

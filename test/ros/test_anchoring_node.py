@@ -205,3 +205,62 @@ def test_anchors_go_into_kant_as_in_a_merlin2_deployment(tmp_path, ros_probe, no
         assert kant.objects.get("kitchen").type == "wp"
     assert anchoring.stop() == 0, anchoring.text
     assert kant_node.process.poll() is None, "KANT's node died"
+
+
+class TfPerceptionStandIn(PerceptionStandIn):
+    """The same frames, with the camera's pose on TF (map -> camera_color_optical_frame) instead of
+    camera_pose; ``with_tf=False`` leaves TF without it."""
+
+    def __init__(self, probe) -> None:
+        import tf2_ros
+
+        super().__init__(probe)
+        self._broadcaster = tf2_ros.TransformBroadcaster(probe.node)
+        self.with_tf = True
+
+    def frame(self, objects) -> None:
+        if self.with_tf:
+            from geometry_msgs.msg import TransformStamped
+
+            now = self._clock.now().nanoseconds * 1e-9
+            transforms = []
+            for stamp in (now, now + 0.5):  # a standing camera: TF interpolates the percepts' stamp
+                transform = TransformStamped(header=Header(stamp=seconds_to_stamp(stamp), frame_id="map"),
+                                             child_frame_id="camera_color_optical_frame")
+                t, r = transform.transform.translation, transform.transform.rotation
+                t.x, t.y, t.z, r.x, r.y, r.z, r.w = DEFAULT_CAMERA_POSE
+                transforms.append(transform)
+            for transform in transforms:
+                self._broadcaster.sendTransform(transform)
+            time.sleep(0.02)
+        super().frame(objects)  # percepts stamped after the transform, as a camera's would be
+
+
+def test_the_camera_pose_from_tf_judges_what_is_in_view(tmp_path, upstream_stack, ros_probe, node_process) -> None:
+    """pose_source tf: the camera info's optical frame looked up in TF at each percept stamp; a frame
+    without that transform is dropped and said so, naming the frames."""
+    upstream_stack("tf2_ros")
+    anchoring = node_process("anchoring", "--ros-args", "-p", f"state_folder:={tmp_path / 'state'}",
+                             "-p", "knowledge_base:=''", "-p", "pose_source:=tf")
+    assert ros_probe.wait_for_node("/anchoring"), anchoring.text
+    camera = TfPerceptionStandIn(ros_probe)
+    time.sleep(1.0)  # discovery between the stand-in's publishers and the node
+
+    camera.with_tf = False
+    for _ in range(2):
+        camera.frame([CUP, BOOK])  # no camera pose anywhere: dropped
+    camera.with_tf = True
+    for _ in range(4):
+        camera.frame([CUP, BOOK])
+    anchors = sorted(latest_anchors(ros_probe))
+    if anchors != ["book_1", "cup_1"]:
+        anchoring.stop()
+    assert anchors == ["book_1", "cup_1"], anchoring.text
+    for _ in range(4):  # the book is in view (by TF's pose) but no longer seen: missing
+        camera.frame([CUP])
+    assert ros_probe.wait_for(
+        lambda: latest_anchors(ros_probe, timeout=2.0).get("book_1", Anchor()).state == Anchor.STATE_MISSING,
+        timeout=10.0), anchoring.text
+    assert anchoring.stop() == 0
+    assert "no transform from 'camera_color_optical_frame' to 'map'" in anchoring.text, anchoring.text
+    assert "Traceback" not in anchoring.text

@@ -10,11 +10,14 @@ fails the test.
 
 from __future__ import annotations
 
+import importlib.util
 import math
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -95,7 +98,8 @@ class SceneCamera:
     """Publishes a synthetic camera's topics from the probe node, as a driver plus odometry would."""
 
     def __init__(self, probe: Any, namespace: str, depth_source: str = "depth_image",
-                 pose_message: str = "PoseStamped", detections_topic: str = "detections") -> None:
+                 pose_message: str = "PoseStamped", detections_topic: str = "detections",
+                 detections_type: Any = DetectionArray) -> None:
         node, self._probe = probe.node, probe
         self._depth_source, self._pose_message = depth_source, pose_message
         self.image = node.create_publisher(Image, f"{namespace}/color/image_raw", SENSOR_DATA)
@@ -106,7 +110,7 @@ class SceneCamera:
         self.pose = (node.create_publisher(PoseStamped, f"{namespace}/camera_pose", SENSOR_DATA)
                      if pose_message == "PoseStamped"
                      else node.create_publisher(Odometry, f"{namespace}/odom", SENSOR_DATA))
-        self.detections = node.create_publisher(DetectionArray, f"{namespace}/{detections_topic}", SENSOR_DATA)
+        self.detections = node.create_publisher(detections_type, f"{namespace}/{detections_topic}", SENSOR_DATA)
 
     def wait_until_connected(self) -> bool:
         publishers = (self.image, self.info, self.depth, self.pose, self.detections)
@@ -115,8 +119,9 @@ class SceneCamera:
         return connected
 
     def publish(self, stamp: float, camera_to_world: Pose, frame: SyntheticFrame,
-                detections: list[Any] | None = None, **overrides: Any) -> None:
-        """Publish one frame; ``overrides`` replaces a message by topic name (info, image, depth, pose)."""
+                detections: list[Any] | None = None, detections_message: Any = None, **overrides: Any) -> None:
+        """Publish one frame; ``overrides`` replaces a message by topic name (info, image, depth, pose),
+        ``detections_message`` the detections (another detector's type, its header set here)."""
         header = Header(stamp=seconds_to_stamp(stamp), frame_id="camera_color_optical_frame")
         if detections is None:
             detections = [detection_to_message(Detection(0, "plate", 0.9, frame.plate_box))]
@@ -128,6 +133,9 @@ class SceneCamera:
             "pose": self._pose(header, camera_to_world),
             "detections": DetectionArray(header=header, detections=detections),
         }
+        if detections_message is not None:
+            detections_message.header = header
+            messages["detections"] = detections_message
         messages.update(overrides)
         for name, message in messages.items():
             getattr(self, name).publish(message)
@@ -306,6 +314,39 @@ def test_percepts_stay_at_the_true_world_position_while_the_camera_moves(
     assert "external detection dropped" in detector.text and "Traceback" not in log
 
 
+@pytest.mark.parametrize("detections_type", ["yolo_msgs", "vision_msgs"])
+def test_percepts_from_a_robots_own_detector_message_type(
+    detections_type, upstream_stack, ros_probe, node_process, subscribe
+) -> None:
+    """yolo_ros' and vision_msgs' detections, read directly: the same percepts as the project's type."""
+    upstream_stack(f"{detections_type}.msg")
+    sys.path.insert(0, str(Path(__file__).resolve().parent))  # test/ros is not a package: its helpers
+    from detector_messages import vision_array, yolo_array
+
+    namespace = f"/{detections_type}"
+    percept_arrays = subscribe(PerceptArray, f"{namespace}/percepts")
+    generator = node_process("percept_generator", "--ros-args", "-r", f"__ns:={namespace}",
+                             "-p", f"detections_type:={detections_type}", "-p", "tracker_frame_rate:=10.0")
+    to_message = yolo_array if detections_type == "yolo_msgs" else vision_array
+    camera = SceneCamera(ros_probe, namespace, detections_type=type(to_message([])))
+    assert camera.wait_until_connected(), generator.text
+
+    start, pose = 3000.0, camera_pose((0.0, 0.0, 0.9), 0.0)
+    frame = render(pose)
+    for k in range(5):
+        camera.publish(start + 0.1 * k, pose, frame,
+                       detections_message=to_message([Detection(0, "plate", 0.9, frame.plate_box)]))
+        time.sleep(0.1)
+    ros_probe.wait_for(lambda: len(percept_arrays) >= 4, timeout=10.0)
+    assert generator.stop() == 0
+    assert len(percept_arrays) >= 4, generator.text
+    assert f"detections as {detections_type}/msg/" in generator.text
+    for array in percept_arrays:
+        (percept,) = percepts_from_message(array)
+        assert percept.class_name == "plate"
+        np.testing.assert_allclose(percept.position, PLATE_CENTRE, atol=0.02, err_msg=generator.text)
+
+
 # --- bad input ----------------------------------------------------------------------------------
 
 
@@ -373,7 +414,14 @@ def test_percept_generator_logs_bad_input_and_keeps_publishing(ros_probe, node_p
     [
         ("detector", "backend:=ultralytics", "needs the parameter 'weights'"),
         ("detector", "backend:=yolo", "backend must be one of external, ssd_mobilenet, ultralytics"),
-        ("percept_generator", "pose_source:=tf", "tf2_ros, which is not installable from PyPI"),
+        pytest.param("percept_generator", "pose_source:=tf", "tf2_ros, which is not installable from PyPI",
+                     marks=pytest.mark.skipif(importlib.util.find_spec("tf2_ros") is not None,
+                                              reason="tf2_ros is installed here (SAILOR_UPSTREAM): the TF tests "
+                                                     "below run pose_source tf for real")),
+        ("percept_generator", "detections_type:=darknet", "detections_type' must be one of"),
+        pytest.param("percept_generator", "detections_type:=vision_msgs", "need the vision_msgs package",
+                     marks=pytest.mark.skipif(importlib.util.find_spec("vision_msgs") is not None,
+                                              reason="vision_msgs is installed here (SAILOR_UPSTREAM)")),
         ("percept_generator", "camera_extrinsics:=[1.0, 2.0]", "camera_extrinsics must be"),
     ],
 )
@@ -384,3 +432,78 @@ def test_configuration_errors_stop_the_node_with_a_clear_message(executable, par
     process.process.wait(timeout=30.0)
     assert process.stop() == 2, process.text
     assert message in process.text and "Traceback" not in process.text
+
+
+# --- the camera pose from TF (real tf2_ros, built from SAILOR_UPSTREAM) ---------------------------
+
+
+def transform_message(parent: str, child: str, pose: Pose, stamp: Any) -> Any:
+    from geometry_msgs.msg import Quaternion, TransformStamped, Vector3
+
+    message = TransformStamped(header=Header(stamp=stamp, frame_id=parent), child_frame_id=child)
+    x, y, z, w = (float(value) for value in pose.quaternion_xyzw)
+    tx, ty, tz = (float(value) for value in pose.translation)
+    message.transform.translation = Vector3(x=tx, y=ty, z=tz)
+    message.transform.rotation = Quaternion(x=x, y=y, z=z, w=w)
+    return message
+
+
+def test_percepts_from_the_camera_pose_in_tf_through_static_and_moving_frames(
+    upstream_stack, ros_probe, node_process, subscribe
+) -> None:
+    """map -> base_link moves (on /tf); base_link -> camera_link -> camera_color_optical_frame is
+    the robot's description (on /tf_static). A frame whose stamp TF cannot reach is dropped, with
+    one line naming the frames and the latest stamp TF has."""
+    upstream_stack("tf2_ros", "tf2_msgs.msg")
+    import tf2_ros
+    from tf2_msgs.msg import TFMessage
+
+    namespace = "/tf_camera"
+    percept_arrays = subscribe(PerceptArray, f"{namespace}/percepts")
+    generator = node_process("percept_generator", "--ros-args", "-r", f"__ns:={namespace}",
+                             "-p", "pose_source:=tf", "-p", "tracker_frame_rate:=10.0")
+    base_to_camera_link = Pose(np.eye(3), CAMERA_EXTRINSICS[:3])
+    camera_link_to_optical = Pose.from_quaternion(CAMERA_EXTRINSICS[3:])
+    base_to_optical = base_to_camera_link.compose(camera_link_to_optical)
+    np.testing.assert_allclose(base_to_optical.translation, CAMERA_EXTRINSICS[:3])
+    static = tf2_ros.StaticTransformBroadcaster(ros_probe.node)
+    static.sendTransform([
+        transform_message("base_link", "camera_link", base_to_camera_link, seconds_to_stamp(0.0)),
+        transform_message("camera_link", "camera_color_optical_frame", camera_link_to_optical, seconds_to_stamp(0.0)),
+    ])
+    camera = SceneCamera(ros_probe, namespace)
+    camera.pose = ros_probe.node.create_publisher(TFMessage, "/tf", 100)  # the robot's moving base
+    assert camera.wait_until_connected(), generator.text
+
+    frame_count, start = 10, 4000.0
+    poses = [camera_pose((0.05 * k, -0.3 + 0.06 * k, 0.9 + 0.02 * k), -6.0 + 1.2 * k) for k in range(frame_count)]
+    for k, pose in enumerate(poses):
+        stamp = seconds_to_stamp(start + 0.1 * k)
+        map_to_base = pose.compose(base_to_optical.inverse())
+        moving = TFMessage(transforms=[transform_message("map", "base_link", map_to_base, stamp)])
+        camera.pose.publish(moving)
+        time.sleep(0.02)  # the transform reaches the buffer before the detector has answered
+        camera.publish(start + 0.1 * k, pose, render(pose), pose=moving)
+        time.sleep(0.08)
+    ros_probe.wait_for(lambda: any(stamp_of(a) == pytest.approx(start + 0.9) for a in percept_arrays), timeout=5.0)
+    # A frame far past the last transform: dropped, said once, with what TF has; then one with its
+    # transform again, whose percepts say the node has handled the late one.
+    last = poses[-1]
+    camera.publish(start + 60.0, last, render(last), pose=TFMessage())
+    again = TFMessage(transforms=[transform_message("map", "base_link", last.compose(base_to_optical.inverse()),
+                                                    seconds_to_stamp(start + 1.0))])
+    camera.pose.publish(again)
+    time.sleep(0.02)
+    camera.publish(start + 1.0, last, render(last), pose=again)
+    ros_probe.wait_for(lambda: any(stamp_of(a) == pytest.approx(start + 1.0) for a in percept_arrays), timeout=5.0)
+    assert generator.stop() == 0
+    log = generator.text
+
+    assert len(percept_arrays) >= frame_count - 2, log
+    assert all(stamp_of(array) < start + 30.0 for array in percept_arrays)  # the late frame was dropped
+    for array in percept_arrays:
+        (percept,) = percepts_from_message(array)
+        np.testing.assert_allclose(percept.position, PLATE_CENTRE, atol=0.02, err_msg=log)
+    assert "no transform from 'camera_color_optical_frame' to 'map' at 4060.000" in log, log
+    assert "the latest transform between them is at 4000.9" in log, log
+    assert "frame(s) without a transform since the start" in log and "Traceback" not in log
