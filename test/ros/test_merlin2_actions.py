@@ -58,32 +58,31 @@ def registered_action(location: str, name: str):  # noqa: ANN201 - a PddlAction 
         return kant.actions.get(name)
 
 
+def navigation_registered_by(module: str, location: str, ros_probe) -> tuple[object, int, str]:  # noqa: ANN001
+    """Start ``module`` until KANT holds its ``navigation`` action; that action, then its exit status
+    and output once stopped with Ctrl-C."""
+    process = subprocess.Popen([sys.executable, "-m", module, "navigation"], stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, text=True)
+    try:
+        assert ros_probe.wait_for(lambda: registered_action(location, "navigation") is not None,
+                                  timeout=START_SECONDS), f"{module}'s navigation never appeared in KANT"
+        action = registered_action(location, "navigation")
+    finally:
+        process.send_signal(signal.SIGINT)
+        output, _ = process.communicate(timeout=30)
+    return action, process.returncode, output
+
+
 def test_sailors_navigation_is_merlin2s_navigation_as_kant_holds_it(start_kant_node, ros_probe) -> None:
     """SAILOR's navigation can stand in for merlin2_basic_actions': the same PDDL action in KANT."""
     kant = start_kant_node("/merlin2")
-    merlin2 = subprocess.Popen(
-        [sys.executable, "-m", "merlin2_basic_actions.merlin2_navigation_fsm_action"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
-    try:
-        assert ros_probe.wait_for(lambda: registered_action(kant.location, "navigation") is not None,
-                                  timeout=START_SECONDS), "MERLIN2's navigation never appeared in KANT"
-        merlin2_navigation = registered_action(kant.location, "navigation")
-    finally:
-        merlin2.send_signal(signal.SIGINT)
-        merlin2.wait(timeout=30)
+    merlin2_navigation, _, _ = navigation_registered_by(
+        "merlin2_basic_actions.merlin2_navigation_fsm_action", kant.location, ros_probe)
     with open_store(kant.location) as store:  # MERLIN2's action may outlive its process
         store.actions.delete("navigation")
-    sailor = subprocess.Popen(
-        [sys.executable, "-m", "merlin2_sailor_behaviors.merlin2.run", "navigation"],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, text=True)
-    try:
-        assert ros_probe.wait_for(lambda: registered_action(kant.location, "navigation") is not None,
-                                  timeout=START_SECONDS), "SAILOR's navigation never appeared in KANT"
-        sailor_navigation = registered_action(kant.location, "navigation")
-    finally:
-        sailor.send_signal(signal.SIGINT)
-        output, _ = sailor.communicate(timeout=30)
-    assert sailor.returncode == 0, output
+    sailor_navigation, code, output = navigation_registered_by(
+        "merlin2_sailor_behaviors.merlin2.run", kant.location, ros_probe)
+    assert code == 0, output
     # The same action: effects compared as a set (MERLIN2 lists the at-end effect first).
     def signature(action):  # noqa: ANN001, ANN202
         return (action.name, action.parameters, set(action.conditions), set(action.effects), action.durative,
