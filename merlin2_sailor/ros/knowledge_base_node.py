@@ -36,6 +36,7 @@ from merlin2_sailor.ros.knowledge_base_services import (
 from merlin2_sailor.ros.node_runner import run_node
 from merlin2_sailor.ros.parameters import declare_parameter
 from merlin2_sailor.ros.qos import EVENTS
+from merlin2_sailor.ros.service_clash import ServiceClash, ServiceClashWatch
 from merlin2_sailor_interfaces import srv
 from merlin2_sailor_interfaces.msg import KnowledgeChanges
 
@@ -61,8 +62,24 @@ class KnowledgeBaseNode(Node):
         for services in KIND_SERVICES:
             self._serve_kind(services)
         self.create_service(srv.ApplyChanges, APPLY_CHANGES_SERVICE, self._apply_changes)
+        self.exit_code: int | None = None
+        self._clash_watch = ServiceClashWatch(self, self._served(), self._on_service_clash)
         counts = ", ".join(f"{len(self._store.get_all(s.kind))} {s.plural}" for s in KIND_SERVICES)
         self.get_logger().info(f"serving the '{location}' store ({counts})")
+
+    def _served(self) -> list[tuple[str, str]]:
+        """Our services as (fully qualified name, 'pkg/srv/Type')."""
+        return [(name, kinds[0]) for name, kinds in self.get_service_names_and_types_by_node(
+            self.get_name(), self.get_namespace()) if kinds]
+
+    def _on_service_clash(self, clash: ServiceClash) -> None:
+        """A knowledge base whose service names another serves with other types cannot be reached
+        reliably: say so and stop, rather than answer some of the calls meant for the other."""
+        self.get_logger().error(
+            f"{clash}: another knowledge base (KANT's, in a MERLIN2 deployment) serves this namespace; run this "
+            f"node in a namespace of its own (-r __ns:=/sailor, store location ros:///sailor), or use KANT's "
+            "(knowledge_base kant+ros:///merlin2). Stopping.")
+        self.exit_code = 2
 
     def destroy_node(self) -> None:
         self._unsubscribe()

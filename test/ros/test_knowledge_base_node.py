@@ -115,3 +115,15 @@ def test_killed_at_random_moments_the_node_loses_no_acknowledged_write(tmp_path,
     assert stored_objects <= set(symbols)  # nothing appears that was never asked for
     assert len(stored_facts) == len(set(stored_facts)) == len(stored_objects)  # no duplicate, no orphan
     assert set(stored_facts) == stored_objects  # every stored object came with its fact: batches are whole
+
+
+def test_beside_kants_node_in_one_namespace_it_says_so_and_stops(start_kant_node, node_process) -> None:
+    """KANT's node serves get_types, update_type, ... with kant_msgs types; in the same namespace the
+    two would answer each other's clients. The SAILOR node names the clash and exits 2."""
+    namespace = f"/clash_{uuid.uuid4().hex[:8]}"
+    start_kant_node(namespace)
+    process = node_process("knowledge_base", "--ros-args", "-r", f"__ns:={namespace}")
+    process.process.wait(timeout=30.0)
+    assert process.stop() == 2, process.text
+    assert f"{namespace}/get_types is also served by {namespace}/knowledge_base_node as kant_msgs/srv/" in process.text
+    assert "run this node in a namespace of its own" in process.text and "Traceback" not in process.text
