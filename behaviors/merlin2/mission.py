@@ -14,6 +14,7 @@ actions (SAILOR's, run by ``merlin2_sailor_behaviors.merlin2.run``). The mission
   anything runs;
 * declares ``robot_at(<waypoint nearest the robot>)`` (or ``--start``) when the knowledge base
   says nowhere, as the ``behaviors`` node does;
+* waits for KANT's node (up to ``--wait``) before touching KANT's DAOs, which wait without one;
 * waits for MERLIN2 with a deadline (MERLIN2's goal dispatcher waits forever): past it, the
   executor's goal is cancelled and the mission fails.
 
@@ -53,6 +54,8 @@ ROBOT_POSE_TOPIC = "/robot_pose"
 CANCEL_SECONDS = 10.0
 DEFAULT_WAIT_SECONDS = 60.0
 KNOWLEDGE_POLL_SECONDS = 0.5
+KANT_LOCATION = "kant+ros:///merlin2"
+"""MERLIN2's knowledge base: KANT's node in MERLIN2's fixed namespace."""
 T = TypeVar("T")
 GOAL_PATTERN = re.compile(r"^\s*([A-Za-z][\w-]*)\s*\(\s*([^()]*)\)\s*$")
 
@@ -251,6 +254,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     import rclpy
 
+    from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_behaviors.merlin2.node_threads import let_node_threads_end, ros_shutdown_ends_node_threads
 
     rclpy.init(args=arguments)
@@ -258,6 +262,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         node = node_class()
         logger = node.get_logger()
+        # KANT's DAOs wait for its node without a deadline: make sure it answers first.
+        when_known(lambda: open_store(KANT_LOCATION, timeout=KNOWLEDGE_POLL_SECONDS * 4).close(), options.wait)
         dao_factory = node.goal_dispatcher.get_dao_factory()
         store = KantStore(dao_factory)
         dtos = when_known(lambda: goal_dtos(dao_factory, goals), options.wait)

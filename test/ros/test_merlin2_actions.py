@@ -90,3 +90,14 @@ def test_sailors_navigation_is_merlin2s_navigation_as_kant_holds_it(start_kant_n
 
     assert signature(sailor_navigation) == signature(merlin2_navigation)
     assert [(p.name, p.type) for p in sailor_navigation.parameters] == [("o", "wp"), ("d", "wp")]
+
+
+def test_a_mission_without_kant_is_one_line_and_status_2_not_a_hang(upstream_stack) -> None:
+    """KANT's DAOs wait for its node forever; the mission node gives up after --wait, saying why."""
+    upstream_stack("merlin2_mission")
+    mission = subprocess.run(
+        [sys.executable, "-m", "merlin2_sailor_behaviors.merlin2.mission", "explored(kitchen)", "--wait", "2"],
+        capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
+    assert mission.returncode == 2, mission.stdout + mission.stderr
+    assert "cannot start: KANT's knowledge base is not reachable" in mission.stderr
+    assert "Traceback" not in mission.stdout + mission.stderr
