@@ -44,6 +44,7 @@ from merlin2_sailor.knowledge.kant_store import KantStore
 from merlin2_sailor.resources import config_path
 from merlin2_sailor_behaviors.actions.places import Places
 from merlin2_sailor_behaviors.actions.robot_location import declare_robot_at, robot_locations
+from merlin2_sailor_behaviors.merlin2.kant import wait_for_kant
 
 MISSION_MODULE = "merlin2_mission"
 NODE_NAME = "sailor_mission_node"
@@ -54,8 +55,6 @@ ROBOT_POSE_TOPIC = "/robot_pose"
 CANCEL_SECONDS = 10.0
 DEFAULT_WAIT_SECONDS = 60.0
 KNOWLEDGE_POLL_SECONDS = 0.5
-KANT_LOCATION = "kant+ros:///merlin2"
-"""MERLIN2's knowledge base: KANT's node in MERLIN2's fixed namespace."""
 T = TypeVar("T")
 GOAL_PATTERN = re.compile(r"^\s*([A-Za-z][\w-]*)\s*\(\s*([^()]*)\)\s*$")
 
@@ -254,7 +253,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     import rclpy
 
-    from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_behaviors.merlin2.node_threads import let_node_threads_end, ros_shutdown_ends_node_threads
 
     rclpy.init(args=arguments)
@@ -262,8 +260,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         node = node_class()
         logger = node.get_logger()
-        # KANT's DAOs wait for its node without a deadline: make sure it answers first.
-        when_known(lambda: open_store(KANT_LOCATION, timeout=KNOWLEDGE_POLL_SECONDS * 4).close(), options.wait)
+        wait_for_kant(options.wait)  # KANT's DAOs would wait for it without a deadline
         dao_factory = node.goal_dispatcher.get_dao_factory()
         store = KantStore(dao_factory)
         dtos = when_known(lambda: goal_dtos(dao_factory, goals), options.wait)

@@ -23,12 +23,15 @@ from merlin2_sailor.errors import SailorError
 from merlin2_sailor.ros.navigation_interface import WAYPOINT_NAVIGATION_ACTION
 from merlin2_sailor_behaviors.actions.context import BehaviorConfig
 from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
+from merlin2_sailor_behaviors.merlin2.kant import wait_for_kant
 from merlin2_sailor_behaviors.merlin2.node_threads import let_node_threads_end, ros_shutdown_ends_node_threads
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 WITHDRAW_SECONDS = 15.0
 """How long withdrawing every action from MERLIN2's knowledge base may take at exit."""
 STOP_POLL_SECONDS = 0.2
+KANT_WAIT_SECONDS = 60.0
+"""How long the actions wait for KANT's node at start (in a launch it may start after them)."""
 """How often the main thread looks for a stop request while the actions run."""
 
 
@@ -40,6 +43,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--waypoint-navigation", default=None, metavar="ACTION",
         help=f"NavigateToWp server to drive to waypoints by name (default: {WAYPOINT_NAVIGATION_ACTION} where "
              "waypoint_navigation_msgs is installed; '' drives to them with NavigateToPose)")
+    parser.add_argument("--wait", type=float, default=KANT_WAIT_SECONDS, metavar="SECONDS",
+                        help="how long to wait for MERLIN2's knowledge base (KANT's node in /merlin2) to answer "
+                             "before registering the actions (default: %(default)s)")
     parser.add_argument("--look-dwell", type=float, default=BehaviorConfig.look_dwell, metavar="SECONDS",
                         help="seconds to stand still after each turn when looking around (default: %(default)s)")
     arguments = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
@@ -67,6 +73,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     nodes: list = []
     executor = MultiThreadedExecutor()
     try:
+        wait_for_kant(options.wait)  # MERLIN2 registers each action through KANT's DAOs, which never give up
         make_context = ros_context_factory(
             options.grounding, config=BehaviorConfig(look_dwell=options.look_dwell),
             waypoint_action=options.waypoint_navigation)

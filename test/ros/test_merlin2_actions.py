@@ -101,3 +101,14 @@ def test_a_mission_without_kant_is_one_line_and_status_2_not_a_hang(upstream_sta
     assert mission.returncode == 2, mission.stdout + mission.stderr
     assert "cannot start: KANT's knowledge base is not reachable" in mission.stderr
     assert "Traceback" not in mission.stdout + mission.stderr
+
+
+def test_actions_without_kant_are_one_line_and_status_2_not_a_hang(upstream_stack) -> None:
+    """MERLIN2 registers an action through KANT's DAOs, which wait forever; run gives up after --wait."""
+    upstream_stack("merlin2_fsm_action")
+    actions = subprocess.run(
+        [sys.executable, "-m", "merlin2_sailor_behaviors.merlin2.run", "explore", "--wait", "2"],
+        capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
+    assert actions.returncode == 2, actions.stdout + actions.stderr
+    assert "cannot start: KANT's knowledge base is not reachable" in actions.stderr
+    assert "Traceback" not in actions.stdout + actions.stderr
