@@ -40,11 +40,11 @@ from rclpy.utilities import remove_ros_args
 
 from merlin2_sailor.errors import DependencyError, KnowledgeError, SailorError
 from merlin2_sailor.knowledge.grounding import GroundingConfig
-from merlin2_sailor.knowledge.kant_store import KantStore
+from merlin2_sailor.knowledge.store import KnowledgeBase
 from merlin2_sailor.resources import config_path
 from merlin2_sailor_behaviors.actions.places import Places
 from merlin2_sailor_behaviors.actions.robot_location import declare_robot_at, robot_locations
-from merlin2_sailor_behaviors.merlin2.kant import wait_for_kant
+from merlin2_sailor_behaviors.merlin2.kant import KANT_LOCATION, wait_for_kant
 
 MISSION_MODULE = "merlin2_mission"
 NODE_NAME = "sailor_mission_node"
@@ -55,6 +55,8 @@ ROBOT_POSE_TOPIC = "/robot_pose"
 CANCEL_SECONDS = 10.0
 DEFAULT_WAIT_SECONDS = 60.0
 KNOWLEDGE_POLL_SECONDS = 0.5
+KANT_EXCHANGE_SECONDS = 5.0
+"""How long one exchange with KANT's node may take before it is asked again."""
 T = TypeVar("T")
 GOAL_PATTERN = re.compile(r"^\s*([A-Za-z][\w-]*)\s*\(\s*([^()]*)\)\s*$")
 
@@ -122,29 +124,31 @@ def goal_mission_class(base: type | None = None) -> type:
     return GoalMissionNode
 
 
-def goal_dtos(dao_factory: Any, goals: Sequence[Goal]) -> list[Any]:
-    """The goals as KANT propositions, each predicate and object as KANT holds it.
+def goal_dtos(store: KnowledgeBase, goals: Sequence[Goal]) -> list[Any]:
+    """The goals as KANT goal propositions, each predicate and object typed as KANT holds it
+    (``store`` reads KANT: a ``kant+ros`` store, whose every exchange has a deadline).
 
     Raises:
         MissionError: a predicate or object the knowledge base does not hold, or a wrong arity.
+        KnowledgeError: KANT did not answer in time.
     """
     dto = importlib.import_module("kant_dto")
-    predicates, objects = dao_factory.create_pddl_predicate_dao(), dao_factory.create_pddl_object_dao()
     result = []
     for goal in goals:
-        predicate = predicates.get(goal.predicate)
+        predicate = store.predicates.get(goal.predicate)
         if predicate is None:
             raise MissionError(f"goal {goal}: the knowledge base has no predicate {goal.predicate!r}; "
                                "are the actions that use it registered?")
-        if len(predicate.get_types()) != len(goal.objects):
-            raise MissionError(f"goal {goal}: {goal.predicate} takes {len(predicate.get_types())} object(s)")
+        if len(predicate.parameter_types) != len(goal.objects):
+            raise MissionError(f"goal {goal}: {goal.predicate} takes {len(predicate.parameter_types)} object(s)")
         arguments = []
         for name in goal.objects:
-            item = objects.get(name)
+            item = store.objects.get(name)
             if item is None:
                 raise MissionError(f"goal {goal}: the knowledge base has no object {name!r} (not anchored yet?)")
-            arguments.append(item)
-        result.append(dto.PddlPropositionDto(predicate, arguments, is_goal=True))
+            arguments.append(dto.PddlObjectDto(dto.PddlTypeDto(item.type), item.name))
+        predicate_dto = dto.PddlPredicateDto(predicate.name, [dto.PddlTypeDto(t) for t in predicate.parameter_types])
+        result.append(dto.PddlPropositionDto(predicate_dto, arguments, is_goal=True))
     return result
 
 
@@ -166,7 +170,7 @@ def when_known(ask: Callable[[], T], timeout: float) -> T:
         time.sleep(KNOWLEDGE_POLL_SECONDS)
 
 
-def place_robot(node: Any, store: KantStore, places: Places, start: str, pose_topic: str, timeout: float) -> str:
+def place_robot(node: Any, store: KnowledgeBase, places: Places, start: str, pose_topic: str, timeout: float) -> str:
     """Where the knowledge base says the robot is; when it says nowhere, ``start`` or the waypoint
     nearest the robot's pose (``robot_pose``), declared.
 
@@ -253,6 +257,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     import rclpy
 
+    from merlin2_sailor.ros.stores import open_store
     from merlin2_sailor_behaviors.merlin2.node_threads import let_node_threads_end, ros_shutdown_ends_node_threads
 
     rclpy.init(args=arguments)
@@ -260,13 +265,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         node = node_class()
         logger = node.get_logger()
+        started = time.monotonic()
         wait_for_kant(options.wait)  # KANT's DAOs would wait for it without a deadline
-        dao_factory = node.goal_dispatcher.get_dao_factory()
-        store = KantStore(dao_factory)
-        dtos = when_known(lambda: goal_dtos(dao_factory, goals), options.wait)
-        place = when_known(lambda: place_robot(node, store, places, options.start, options.robot_pose_topic,
-                                               POSE_TIMEOUT_SECONDS), options.wait)
-        logger.info(f"the robot is at {place}; goals: {', '.join(map(str, goals))}")
+        logger.info(f"KANT answers ({time.monotonic() - started:.1f} s)")
+        # What the mission reads and declares goes through the kant+ros store, whose every exchange
+        # has a deadline: a KANT DAO made just now can lose its first answer to a discovery race
+        # and then waits forever.
+        # Each attempt opens the store afresh: an exchange that timed out may leave its client stuck.
+        def with_kant(ask: Callable[[KnowledgeBase], T]) -> Callable[[], T]:
+            def attempt() -> T:
+                with open_store(KANT_LOCATION, timeout=KANT_EXCHANGE_SECONDS) as store:
+                    return ask(store)
+            return attempt
+
+        dtos = when_known(with_kant(lambda store: goal_dtos(store, goals)), options.wait)
+        logger.info(f"KANT holds what the goals name ({time.monotonic() - started:.1f} s)")
+        place = when_known(with_kant(lambda store: place_robot(
+            node, store, places, options.start, options.robot_pose_topic, POSE_TIMEOUT_SECONDS)), options.wait)
+        logger.info(f"the robot is at {place} ({time.monotonic() - started:.1f} s); goals: "
+                    f"{', '.join(map(str, goals))}")
         outcome = run_goals(node, dtos, options.timeout)
         if outcome is None:
             logger.error(f"MERLIN2 did not achieve the goals within {options.timeout:g} s; cancelled")
