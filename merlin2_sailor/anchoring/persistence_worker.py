@@ -88,25 +88,17 @@ class PersistenceWorker:
             self._thread.join(timeout=30.0)
         anchors = self._copy_anchors()
         self._save(anchors)
-        self._guarded(lambda: self._sync_knowledge_base(anchors.views))
-        self._save(anchors)  # with the objects the last sync may have created
+        self._guarded(lambda: self._sync_knowledge_base(anchors))
         if self._sync is not None:
             self._sync.close()
         if self._store is not None:
             self._store.close()
 
     def step(self, force_save: bool = False) -> None:
-        """One round: sync the knowledge base, and save the state file when due.
-
-        A sync that created objects forces the save: until the state file holds those anchors
-        and says the objects are ours, a crash would leave them in the knowledge base for good
-        while the restarted node anchored the same things again under new symbols.
-        """
+        """One round: sync the knowledge base, and save the state file when due."""
         anchors = self._copy_anchors()
-        claimed_before = self._claimed
-        self._sync_knowledge_base(anchors.views)
-        created = not self._claimed <= claimed_before
-        if force_save or created or time.monotonic() >= self._next_save:
+        self._sync_knowledge_base(anchors)
+        if force_save or time.monotonic() >= self._next_save:
             self._save(anchors)
 
     def _save(self, anchors: AnchorsCopy) -> None:
@@ -129,7 +121,15 @@ class PersistenceWorker:
         except Exception as error:  # noqa: BLE001 - the worker keeps the anchors safe; it must not die
             self._log("error", f"anchoring persistence step failed, retrying: {error!r}")
 
-    def _sync_knowledge_base(self, views: Sequence[AnchorView]) -> None:
+    def _sync_knowledge_base(self, anchors: AnchorsCopy) -> None:
+        """Bring the knowledge base to ``anchors``.
+
+        Write-ahead: a batch that will create objects is sent only after the state file holds
+        these anchors and claims those objects. A crash after the store applied the batch (even
+        before its answer arrived) then restarts with anchors that own the objects, where it once
+        left them in the knowledge base for good while the restarted node anchored the same things
+        again under new symbols. A claimed object the store never got is simply not adopted.
+        """
         if self._open_knowledge_base is None or self._grounding is None:
             return
         try:
@@ -137,7 +137,11 @@ class PersistenceWorker:
                 self._store = self._open_knowledge_base()
             if self._sync is None:
                 self._sync = KnowledgeSync(self._store, self._grounding, owned=self._claimed)
-            self._sync.sync(views)
+            plan = self._sync.plan(anchors.views)
+            if not plan.created_objects <= self._claimed:
+                self._unconfirmed |= plan.created_objects
+                self._save(anchors)
+            self._sync.apply(plan)
             self._owned = self._sync.owned_objects
             self._unconfirmed = frozenset()
         except SailorError as error:

@@ -11,6 +11,12 @@ exchange one: it first checks that KANT's node is there, then runs the exchange 
 and gives up after ``timeout`` seconds per request, raising KnowledgeError instead of hanging.
 A thread left waiting on a node that died mid-call is abandoned: it holds nothing of the store's,
 and, a daemon, it does not keep the process from exiting.
+
+A read is tried up to READ_ATTEMPTS times within that deadline. Over DDS a service can be listed
+before its answers can reach this client (the server's reply writer has not yet matched the
+client's reader): the request is served and the reply lost, and KANT's DAO then waits forever
+(measured in CI: a store opened on a node that had just started never got its first read). A read
+asks again; a write is not repeated, since KANT would apply it twice.
 """
 
 from __future__ import annotations
@@ -32,6 +38,8 @@ PROBE_SERVICE = "get_types"
 """A service KANT's knowledge-base node always serves: its presence says the node is up."""
 REQUESTS_PER_READ = 5
 """A reload asks KANT for each of its five kinds."""
+READ_ATTEMPTS = 3
+"""How many times a read is asked within its deadline before the store gives up."""
 
 Result = TypeVar("Result")
 
@@ -63,13 +71,23 @@ class KantRosStore(KantStore):
         return cls(namespace=location.removeprefix(SCHEME) or "/", timeout=timeout)
 
     def _load(self) -> list:
-        return self._with_deadline(super()._load, REQUESTS_PER_READ)
+        return self._with_deadline(super()._load, REQUESTS_PER_READ, attempts=READ_ATTEMPTS)
 
     def _persist(self, events: Sequence[ChangeEvent]) -> None:
         # A save may first read what it refers to; allow two requests per change.
         self._with_deadline(lambda: super(KantRosStore, self)._persist(events), 2 * len(events) + 1)
 
-    def _with_deadline(self, exchange: Callable[[], Result], requests: int) -> Result:
+    def _with_deadline(self, exchange: Callable[[], Result], requests: int, attempts: int = 1) -> Result:
+        """Run ``exchange`` within ``timeout`` seconds per request, in up to ``attempts`` equal tries."""
+        deadline = self._timeout * requests
+        for _attempt in range(attempts):
+            answered, value = self._attempt(exchange, deadline / attempts)
+            if answered:
+                return value
+        raise KnowledgeError(f"KANT's knowledge base in {self._namespace} did not answer within {deadline:g} s")
+
+    def _attempt(self, exchange: Callable[[], Result], deadline: float) -> tuple[bool, Result | None]:
+        """(True, result) if the exchange ended within ``deadline``, (False, None) if not; its error is raised."""
         if not self._spinner.context.ok():
             raise KnowledgeError("the ROS context of the KANT store has shut down")
         if not self._probe.wait_for_service(timeout_sec=self._timeout):
@@ -77,7 +95,6 @@ class KantRosStore(KantStore):
                 f"KANT's knowledge base is not reachable: {self._namespace.rstrip('/')}/{PROBE_SERVICE} did not "
                 f"appear within {self._timeout:g} s; is kant_knowledge_base's node running in {self._namespace}?"
             )
-        deadline = self._timeout * requests
         outcome: list[tuple[bool, Any]] = []
 
         def run() -> None:
@@ -92,11 +109,11 @@ class KantRosStore(KantStore):
         worker.start()
         worker.join(deadline)
         if not outcome:
-            raise KnowledgeError(f"KANT's knowledge base in {self._namespace} did not answer within {deadline:g} s")
+            return False, None
         succeeded, value = outcome[0]
         if not succeeded:
             raise value
-        return value
+        return True, value
 
     def _close_database(self) -> None:
         self._spinner.close()

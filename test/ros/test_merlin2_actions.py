@@ -92,23 +92,16 @@ def test_sailors_navigation_is_merlin2s_navigation_as_kant_holds_it(start_kant_n
     assert [(p.name, p.type) for p in sailor_navigation.parameters] == [("o", "wp"), ("d", "wp")]
 
 
-def test_a_mission_without_kant_is_one_line_and_status_2_not_a_hang(upstream_stack) -> None:
-    """KANT's DAOs wait for its node forever; the mission node gives up after --wait, saying why."""
-    upstream_stack("merlin2_mission")
-    mission = subprocess.run(
-        [sys.executable, "-m", "merlin2_sailor_behaviors.merlin2.mission", "explored(kitchen)", "--wait", "2"],
-        capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
-    assert mission.returncode == 2, mission.stdout + mission.stderr
-    assert "cannot start: KANT's knowledge base is not reachable" in mission.stderr
-    assert "Traceback" not in mission.stdout + mission.stderr
-
-
-def test_actions_without_kant_are_one_line_and_status_2_not_a_hang(upstream_stack) -> None:
-    """MERLIN2 registers an action through KANT's DAOs, which wait forever; run gives up after --wait."""
-    upstream_stack("merlin2_fsm_action")
-    actions = subprocess.run(
-        [sys.executable, "-m", "merlin2_sailor_behaviors.merlin2.run", "explore", "--wait", "2"],
-        capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
-    assert actions.returncode == 2, actions.stdout + actions.stderr
-    assert "cannot start: KANT's knowledge base is not reachable" in actions.stderr
-    assert "Traceback" not in actions.stdout + actions.stderr
+@pytest.mark.parametrize(("module", "upstream_module", "arguments"), [
+    ("merlin2_sailor_behaviors.merlin2.mission", "merlin2_mission", ["explored(kitchen)"]),
+    ("merlin2_sailor_behaviors.merlin2.run", "merlin2_fsm_action", ["explore"]),
+], ids=["mission", "actions"])
+def test_without_kant_it_is_one_line_and_status_2_not_a_hang(upstream_stack, module, upstream_module, arguments):
+    """KANT's DAOs wait for its node forever (MERLIN2 registers actions and reads goals through
+    them); the mission and the actions give up after --wait, saying why."""
+    upstream_stack(upstream_module)
+    process = subprocess.run([sys.executable, "-m", module, *arguments, "--wait", "2"],
+                             capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
+    assert process.returncode == 2, process.stdout + process.stderr
+    assert "cannot start: KANT's knowledge base is not reachable" in process.stderr
+    assert "Traceback" not in process.stdout + process.stderr

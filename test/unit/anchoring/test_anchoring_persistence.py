@@ -136,6 +136,41 @@ def test_a_sync_that_creates_objects_saves_the_state_at_once(tmp_path) -> None:
     assert len(state.load().snapshot["anchors"]) == 2
 
 
+class Killed(BaseException):
+    """The process dying: no code of the worker runs after it."""
+
+
+def test_a_node_killed_while_the_knowledge_base_applies_a_new_object_restarts_owning_it(tmp_path) -> None:
+    """Write-ahead: the state file claims an object before the batch that creates it is sent, so a
+    kill at any moment of that batch leaves no object in the knowledge base that nobody owns."""
+    kb = FlakyStore()
+    anchors = [anchor("cup_1", 1.0)]
+    state = AnchoringStateFile(tmp_path)
+    copy = lambda: AnchorsCopy(views_of(anchors), lambda: {"anchors": [a.symbol for a in anchors]})  # noqa: E731
+    worker = PersistenceWorker(copy, state, kb.open, GROUNDING, save_period=3600.0)
+    worker.step()
+    anchors.append(anchor("book_1", 1.2))
+    real_apply = kb.store.apply
+
+    def apply_then_killed(changes):
+        real_apply(changes)
+        raise Killed
+
+    kb.store.apply = apply_then_killed
+    with pytest.raises(Killed):
+        worker.step()
+    kb.store.apply = real_apply
+    assert kb.store.objects.get("book_1") is not None  # the knowledge base has it; the node died
+    saved = state.load()
+    assert saved.snapshot == {"anchors": ["cup_1", "book_1"]} and "book_1" in saved.owned_objects
+    restarted = PersistenceWorker(copy, state, kb.open, GROUNDING, owned_objects=saved.owned_objects)
+    restarted.step()
+    assert restarted.owned_objects == {"cup_1", "book_1"}
+    anchors.pop()  # book_1 forgotten after the restart: its object goes with it
+    restarted.step()
+    assert kb.store.objects.get("book_1") is None
+
+
 def test_objects_created_by_a_batch_whose_answer_was_lost_stay_ours(tmp_path) -> None:
     """A knowledge base killed after committing a batch, before answering: its objects are still
     the anchors' own, saved as such, and deleted with their anchor later (none left behind)."""

@@ -21,7 +21,7 @@ from merlin2_sailor_behaviors.actions import PLAN_STEP_KEY, SailorAction, active
 from merlin2_sailor_behaviors.actions.domain import ACTIONS, PREDICATES
 from merlin2_sailor_behaviors.catalogue import SAILOR_ACTIONS, select_actions
 from merlin2_sailor_behaviors.planning import PlanStep
-from merlin2_sailor_behaviors.state_machines import SUCCEED, CbState, StateMachine
+from merlin2_sailor_behaviors.state_machines import CANCEL, SUCCEED, CbState, StateMachine
 
 from .waiting_state import WaitForCancel
 
@@ -89,18 +89,20 @@ def test_the_blackboard_holds_each_parameters_object_and_the_plan_step() -> None
 
 
 def test_progress_names_the_running_state_through_nested_machines() -> None:
-    inner = StateMachine([SUCCEED])
+    inner = StateMachine([SUCCEED, CANCEL])
     waiting = WaitForCancel()
     inner.add_state("WAITING", waiting)
-    outer = StateMachine([SUCCEED])
+    outer = StateMachine([SUCCEED, CANCEL])
     outer.add_state("SEARCHING", inner)
     assert active_state_path(outer) == ""
-    thread = threading.Thread(target=outer)
+    outcomes = []
+    thread = threading.Thread(target=lambda: outcomes.append(outer()))
     thread.start()
     assert waiting.started.wait(5.0)
     assert active_state_path(outer) == "SEARCHING/WAITING"
     outer.cancel_state()
     thread.join(5.0)
+    assert outcomes == [CANCEL]
 
 
 # --- Planning with the registered domain -----------------------------------------------------

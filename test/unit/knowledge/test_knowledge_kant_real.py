@@ -7,6 +7,7 @@ writers, and a knowledge-base node that dies. They skip, saying why, without SAI
 
 from __future__ import annotations
 
+import threading
 import time
 
 import pytest
@@ -98,3 +99,30 @@ def test_a_dead_kant_node_is_an_error_within_the_deadline(kant_node):
         assert time.monotonic() - started < DEADLINE_SECONDS * 8
     finally:
         store.close()
+
+
+@pytest.mark.ros
+def test_a_read_whose_reply_is_lost_is_asked_again(kant_node, monkeypatch):
+    """Over DDS a reply can be lost to a client the server has not yet matched; KANT's DAO then
+    waits forever. The store asks again within the read's deadline instead of failing."""
+    from merlin2_sailor.knowledge.kant_store import KantStore
+
+    real_load, calls = KantStore._load, []
+    never = threading.Event()
+
+    def first_reply_lost(store):
+        calls.append(time.monotonic())
+        if len(calls) == 1:
+            never.wait(60.0)  # the first exchange never hears back
+        return real_load(store)
+
+    with open_store(kant_node.location, timeout=DEADLINE_SECONDS) as writer:
+        writer.apply([Change.save(item) for item in kitchen_scene()])
+    monkeypatch.setattr(KantStore, "_load", first_reply_lost)
+    try:
+        with open_store(kant_node.location, timeout=DEADLINE_SECONDS) as reader:
+            assert reader.objects.get("kitchen") == PddlObject("kitchen", "wp")
+    finally:
+        never.set()
+    # Asked again within one read's deadline (five requests), not after the lost one's 60 s.
+    assert len(calls) >= 2 and calls[1] - calls[0] < DEADLINE_SECONDS * 5
