@@ -17,6 +17,7 @@ PACKAGE_NAME = "merlin2_sailor"
 NODE_ENTRY_POINTS = [
     "rgbd_player = merlin2_sailor_demos.rgbd_player_node:main",
     "topic_monitor = merlin2_sailor.ros.topic_monitor_node:main",
+    "bag_recorder = merlin2_sailor.ros.bag_recorder_node:main",
     "knowledge_base = merlin2_sailor.ros.knowledge_base_node:main",
     "anchoring = merlin2_sailor.ros.anchoring_node:main",
     "detector = merlin2_sailor.ros.detector_node:main",

@@ -64,7 +64,7 @@ class ReplayPipeline:
     def __init__(
         self,
         source: ReplaySource,
-        detector: FrameDetector,
+        detector: FrameDetector | None,
         tracker: FrameTracker | None,
         anchoring: Anchoring | None = None,
         percept_generator: PerceptGenerator | None = None,
@@ -81,7 +81,13 @@ class ReplayPipeline:
     def step(self, frame: ReplayFrame) -> FrameOutcome:
         seconds: dict[str, float] = {}
         started = time.perf_counter()
-        detections = list(self.detector.detect(frame.color))
+        if frame.detections is not None:  # recorded with the frame: what the robot's detector found
+            detections = list(frame.detections)
+        elif self.detector is None:
+            raise ConfigurationError(f"frame {frame.index} of '{self.source.name}' has no recorded detections "
+                                     "and the replay has no detector")
+        else:
+            detections = list(self.detector.detect(frame.color))
         seconds["detect"] = _lap(started)
         started = time.perf_counter()
         if self.tracker is not None:

@@ -46,6 +46,8 @@ class ReplayFrame:
     depth_metres: np.ndarray | None
     intrinsics: CameraIntrinsics
     camera_to_world: Pose
+    detections: tuple[Detection, ...] | None = None
+    """Detections recorded with the frame (a bag's); None: the replay's detector finds them."""
 
 
 class ReplaySource(ABC):

@@ -17,6 +17,7 @@ REPLAY_SOURCES = MappingProxyType(
         "motorcycle": "merlin2_sailor_demos.replay.motorcycle:MotorcycleSource",
         "sr300": "merlin2_sailor_demos.replay.sr300:Sr300CastelSource",
         "vtest": "merlin2_sailor_demos.replay.vtest:VtestSource",
+        "bag": "merlin2_sailor_demos.replay.bag_source:BagSource",
     }
 )
 

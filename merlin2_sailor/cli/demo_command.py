@@ -30,6 +30,7 @@ from pathlib import Path
 
 from merlin2_sailor.cli import launch_command
 from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.launcher.recording import add_record_arguments, with_recorder
 
 DEFAULT_OUTPUT = Path("reports") / "demo"
 #: What a demo run leaves in its output folder: the only entries it removes before a new run.
@@ -78,6 +79,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--deadline", type=float, default=DEFAULT_DEADLINE, metavar="SECONDS",
                         help=f"stop a scenario run after this long and count a hang (default {DEFAULT_DEADLINE:g})")
     launch_command.add_grace_period_argument(parser)
+    add_record_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -109,12 +111,15 @@ def _seed_list(text: str) -> list[int]:
 
 
 def run(arguments: argparse.Namespace) -> int:
+    if arguments.record and (arguments.scenario or arguments.all_scenarios or arguments.soak):
+        raise ConfigurationError("--record records the default demo (or one launch: sailor launch NAME --record)")
     if arguments.list_scenarios:
         return list_scenarios()
     if arguments.scenario or arguments.all_scenarios or arguments.soak:
         return run_scenarios(arguments)
     if arguments.seeds is not None:
         raise ConfigurationError("--seeds runs scenarios: give --scenario NAME or --all-scenarios too")
+
     return run_default(arguments)
 
 
@@ -134,8 +139,14 @@ def run_default(arguments: argparse.Namespace) -> int:
 
     output = prepare_output(arguments.output)
     options = RunOptions(seed=arguments.seed, matcher=arguments.matcher, grace_period=arguments.grace_period)
-    result, _ = launch(demo_launch(output, None, options), None, arguments.grace_period, None)
+    spec = demo_launch(output, None, options)
+    if arguments.record:
+        spec = with_recorder(spec, arguments.record, arguments.record_storage)
+    result, _ = launch(spec, None, arguments.grace_period, None)
     print(result.summary(), flush=True)
+    if arguments.record:
+        print(f"Recorded to {arguments.record}; replay it with: sailor replay bag {arguments.record} --launch demo",
+              flush=True)
     summary = output / "report" / "summary.md"
     print()
     if summary.is_file():

@@ -8,6 +8,7 @@ import signal
 from types import FrameType
 
 from merlin2_sailor.launcher import Supervisor, load_launch_file
+from merlin2_sailor.launcher.recording import add_record_arguments, with_recorder
 from merlin2_sailor.resources import config_file, find_launch_file
 
 # Fast DDS reads its profile from this variable; ours enlarges the shared-memory segment so that
@@ -33,6 +34,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="stop the launch after this many seconds (default: run until Ctrl-C)",
     )
     add_grace_period_argument(parser)
+    add_record_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -45,6 +47,8 @@ def add_grace_period_argument(parser: argparse.ArgumentParser) -> None:
 
 def run(arguments: argparse.Namespace) -> int:
     spec = load_launch_file(find_launch_file(arguments.launch_file))
+    if arguments.record:
+        spec = with_recorder(spec, arguments.record, arguments.record_storage)
     if FAST_DDS_PROFILE_VARIABLE not in os.environ and FAST_DDS_PROFILE_VARIABLE not in spec.environment:
         spec.environment[FAST_DDS_PROFILE_VARIABLE] = str(config_file("fastdds.xml"))
     supervisor = Supervisor(spec, grace_period=arguments.grace_period)

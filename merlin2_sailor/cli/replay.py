@@ -4,9 +4,10 @@ No ROS: the core classes run directly (detector -> ByteTrack -> percept generato
 over the frames of a source, and the output folder receives annotated PNGs, a video and an
 anchors summary (anchors.json, anchors.md). Sources: ``motorcycle`` (scikit-image's Middlebury
 frame, a sideways-sliding camera), ``sr300`` (ViSP's real SR300 RGB-D sequence, Debian
-visp-images-data) and ``vtest`` (OpenCV's pedestrian video, Debian opencv-doc, depth from a
-ground-plane model). The Debian data is fetched into a cache on first use when not installed.
-See ``merlin2_sailor_demos.replay``.
+visp-images-data), ``vtest`` (OpenCV's pedestrian video, Debian opencv-doc, depth from a
+ground-plane model) and ``bag PATH`` (a rosbag2 bag, MCAP or SQLite3: a robot's recording or
+``sailor demo --record``'s; its recorded detections are used where it has them). The Debian
+data is fetched into a cache on first use when not installed. See ``merlin2_sailor_demos.replay``.
 """
 
 from __future__ import annotations
@@ -15,8 +16,10 @@ import argparse
 from pathlib import Path
 
 from merlin2_sailor.cli.anchoring_settings import add_settings_arguments, parameter_sources, set_parameters
+from merlin2_sailor.cli.bag_replay_options import add_bag_arguments, bag_options
+from merlin2_sailor.errors import ConfigurationError
 
-SOURCES = ("motorcycle", "sr300", "vtest")
+SOURCES = ("motorcycle", "sr300", "vtest", "bag")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -28,6 +31,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("source", metavar="SOURCE",
                         help=f"one of {', '.join(SOURCES)}")
+    parser.add_argument("path", nargs="?", default="", metavar="PATH",
+                        help="bag: the rosbag2 bag (its folder, or an .mcap / .db3 file)")
     parser.add_argument("--output", default="", metavar="DIR", help="output folder (default reports/replay/SOURCE)")
     parser.add_argument("--frames", type=int, default=None, metavar="N",
                         help="frames to process (default: the source's, about a minute at most: "
@@ -53,12 +58,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                        help="camera pitch below the horizon in degrees (default 34)")
     vtest.add_argument("--field-of-view", type=float, default=None, metavar="DEG",
                        help="horizontal field of view in degrees (default 60)")
+    add_bag_arguments(parser)
     add_settings_arguments(parser)
     parser.set_defaults(run=run)
 
 
 def source_options(arguments: argparse.Namespace) -> dict[str, object]:
     """The source's configuration fields given on the command line (the others keep their defaults)."""
+    if arguments.source == "bag":
+        return bag_options(arguments)
+    if arguments.path:
+        raise ConfigurationError(f"the '{arguments.source}' source takes no PATH (only bag does; see --data)")
     given = {
         "data": arguments.data or None,
         "camera_height": arguments.camera_height,
@@ -71,7 +81,6 @@ def source_options(arguments: argparse.Namespace) -> dict[str, object]:
 def run(arguments: argparse.Namespace) -> int:
     from merlin2_sailor.anchoring.service import AnchoringService
     from merlin2_sailor.anchoring.settings import parameter_values
-    from merlin2_sailor.errors import ConfigurationError
     from merlin2_sailor_demos.replay.pipeline import ReplayPipeline, create_replay_detector, create_replay_tracker
     from merlin2_sailor_demos.replay.runner import ReplayOptions, format_summary, run_replay
     from merlin2_sailor_demos.replay.sources import create_source, source_class
@@ -87,14 +96,16 @@ def run(arguments: argparse.Namespace) -> int:
     overrides = {**({"matcher": arguments.matcher} if arguments.matcher else {}), **set_parameters(arguments)}
     source = create_source(arguments.source, source_options(arguments))
     settings = source.anchoring_settings(*parameter_files, overrides=overrides, node=node)
-    detector = create_replay_detector(arguments.detector, arguments.score_threshold)
+    recorded = getattr(source, "uses_recorded_detections", False)
+    detector = None if recorded else create_replay_detector(arguments.detector, arguments.score_threshold)
     service = AnchoringService(settings)
     pipeline = ReplayPipeline(source, detector, create_replay_tracker(source, arguments.stride), service.anchoring)
     output = Path(arguments.output) if arguments.output else Path("reports") / "replay" / source.name
     options = ReplayOptions(
         output=output, frames=arguments.frames, stride=arguments.stride, first=arguments.first,
         image_every=arguments.every, video=not arguments.no_video,
-        header={"detector": arguments.detector, "score_threshold": arguments.score_threshold,
+        header={"detector": "recorded" if recorded else arguments.detector,
+                "score_threshold": None if recorded else arguments.score_threshold,
                 "matcher": settings.matcher.name,
                 "parameter_files": [str(item) if isinstance(item, Path) else item for item in parameter_files],
                 "anchoring": parameter_values(settings)},

@@ -72,6 +72,11 @@ def seen_twice(anchoring, maker, items, start, camera=True, positions=None):
         see(anchoring, maker, items, start + frame * FRAME, camera, positions)
 
 
+def symbol_at(anchoring, item):
+    """The symbol of the anchor nearest ``item``: new anchors of one frame are numbered by place."""
+    return min(anchoring.anchors, key=lambda anchor: np.linalg.norm(anchor.position - item.position)).symbol
+
+
 def search_living_room(anchoring, symbol, stamp):
     return anchoring.expect(symbol, Expectation.at(LIVING_ROOM, stamp, "living_room", "find", radius=1.5))
 
@@ -82,13 +87,14 @@ def kinds(result):
 
 def test_a_look_alike_moved_while_its_twin_stays_is_found_under_its_own_symbol(anchoring, maker):
     seen_twice(anchoring, maker, [KITCHEN_MUG, TWIN], 0.0)
+    mug, twin = symbol_at(anchoring, KITCHEN_MUG), symbol_at(anchoring, TWIN)
     see(anchoring, maker, [TWIN], 1.0)  # the kitchen: the twin is there, the other mug is not
-    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    assert anchoring.get(mug).state is AnchorState.MISSING
     seen_twice(anchoring, maker, [KITCHEN_MUG], 2.0, camera=False, positions={"blue_mug": LIVING_ROOM})
-    result = search_living_room(anchoring, "cup_1", 3.0)
-    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, "cup_1")]
-    np.testing.assert_allclose(anchoring.get("cup_1").position, LIVING_ROOM, atol=0.05)
-    assert anchoring.get("cup_2").state is AnchorState.CONFIRMED  # the twin keeps its own symbol
+    result = search_living_room(anchoring, mug, 3.0)
+    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, mug)]
+    np.testing.assert_allclose(anchoring.get(mug).position, LIVING_ROOM, atol=0.05)
+    assert anchoring.get(twin).state is AnchorState.CONFIRMED  # the twin keeps its own symbol
 
 
 def test_a_removed_object_is_never_reported_found_as_another_of_its_class(anchoring, maker):
@@ -149,17 +155,18 @@ def test_a_search_under_way_recognises_the_object_when_it_is_anchored_anew(ancho
     saw it from afar, outside the searched disc's reach of the matching gate); the confirmation
     itself brings it into question, and the search finds it."""
     seen_twice(anchoring, maker, [KITCHEN_MUG, GREEN_MUG], 0.0)
+    mug, green = symbol_at(anchoring, KITCHEN_MUG), symbol_at(anchoring, GREEN_MUG)
     see(anchoring, maker, [GREEN_MUG], 1.0)
-    assert anchoring.get("cup_1").state is AnchorState.MISSING
-    assert search_living_room(anchoring, "cup_1", 1.5).events == ()  # nothing new yet: the green one is older
+    assert anchoring.get(mug).state is AnchorState.MISSING
+    assert search_living_room(anchoring, mug, 1.5).events == ()  # nothing new yet: the green one is older
     moved = np.array((1.5, 8.0, 0.8))  # 2 m from the centre: beyond the disc, within its tolerance
     found = None
     for frame in range(2):
         result = see(anchoring, maker, [KITCHEN_MUG], 2.0 + frame * FRAME, camera=False,
                      positions={"blue_mug": moved})
         found = found or next((e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN), None)
-    assert found is not None and found.details["reason"].endswith("it is cup_1")
-    cup = anchoring.get("cup_1")
+    assert found is not None and found.details["reason"].endswith(f"it is {mug}")
+    cup = anchoring.get(mug)
     assert cup.state is AnchorState.CONFIRMED and cup.expectation is None
     np.testing.assert_allclose(cup.position, moved, atol=0.05)
-    assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and len(anchoring) == 2
+    assert anchoring.get(green).state is AnchorState.CONFIRMED and len(anchoring) == 2

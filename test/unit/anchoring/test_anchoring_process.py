@@ -278,6 +278,18 @@ def test_invalid_percept_geometry_is_refused(make_anchoring, maker, kitchen):
         make_anchoring().process([percept], None, 0.0)
 
 
+@pytest.mark.parametrize("order", [(0, 1, 2, 3), (3, 2, 1, 0), (2, 0, 3, 1)])
+def test_one_frames_new_anchors_are_numbered_by_place_whatever_the_detectors_order(make_anchoring, maker, order):
+    """A detector may list one frame's objects in any order: a live run and a replay of its bag
+    must still give each object the same symbol."""
+    cups = [SceneObject(f"cup_{n}", "cup", (1.0 + 0.5 * n, 0.2 * (n % 2), 0.8)) for n in range(3)]
+    items = [*cups, SceneObject("book", "book", (1.2, 1.0, 0.8))]
+    anchoring = make_anchoring()
+    result = anchoring.process([maker.percept(items[index], 0.0) for index in order], camera_view(), 0.0)
+    symbols = dict(zip((items[index].identity for index in order), result.percept_symbols, strict=True))
+    assert symbols == {"cup_0": "cup_1", "cup_1": "cup_2", "cup_2": "cup_3", "book": "book_1"}
+
+
 def test_symbols_come_from_the_given_factory(maker, kitchen):
     issued = []
 

@@ -117,7 +117,7 @@ def test_only_the_wanted_part_of_a_package_is_unpacked_into_the_cache(tmp_path) 
 
 
 def test_sources_are_chosen_by_name_and_refuse_options_they_lack(tmp_path) -> None:
-    assert set(REPLAY_SOURCES) == {"motorcycle", "sr300", "vtest"}
+    assert set(REPLAY_SOURCES) == {"motorcycle", "sr300", "vtest", "bag"}
     with pytest.raises(ConfigurationError, match="choose one of motorcycle, sr300, vtest"):
         create_source("kitchen")
     with pytest.raises(ConfigurationError, match="no option camera_pitch"):
