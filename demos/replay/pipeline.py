@@ -8,6 +8,8 @@ messages. The detector and the tracker are anything with the core's verbs (``det
 
 from __future__ import annotations
 
+import contextlib
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -68,7 +70,10 @@ class ReplayPipeline:
         tracker: FrameTracker | None,
         anchoring: Anchoring | None = None,
         percept_generator: PerceptGenerator | None = None,
+        lock: threading.Lock | None = None,
     ) -> None:
+        """``lock``: held while a frame is anchored, where another thread reads the anchors (the
+        anchoring service's persistence worker, when the replay writes a knowledge base)."""
         self.source = source
         self.detector = detector
         self.tracker = tracker
@@ -77,6 +82,7 @@ class ReplayPipeline:
         self.percept_generator = (
             PerceptGenerator(source.percept_config()) if percept_generator is None else percept_generator
         )
+        self._lock = lock if lock is not None else contextlib.nullcontext()
 
     def step(self, frame: ReplayFrame) -> FrameOutcome:
         seconds: dict[str, float] = {}
@@ -101,7 +107,8 @@ class ReplayPipeline:
         seconds["percepts"] = _lap(started)
         started = time.perf_counter()
         view = CameraView(frame.intrinsics, frame.camera_to_world, depth)
-        result = self.anchoring.process(batch.percepts, view, frame.stamp)
+        with self._lock:
+            result = self.anchoring.process(batch.percepts, view, frame.stamp)
         seconds["anchoring"] = _lap(started)
 
         # The generator keeps detection order and lists each dropped detection itself, so the

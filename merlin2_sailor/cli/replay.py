@@ -20,6 +20,7 @@ from merlin2_sailor.cli.bag_replay_options import add_bag_arguments, bag_options
 from merlin2_sailor.errors import ConfigurationError
 
 SOURCES = ("motorcycle", "sr300", "vtest", "bag")
+KNOWLEDGE_FILE = "knowledge.db"
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -95,12 +96,18 @@ def run(arguments: argparse.Namespace) -> int:
     parameter_files, node = parameter_sources(arguments)
     overrides = {**({"matcher": arguments.matcher} if arguments.matcher else {}), **set_parameters(arguments)}
     source = create_source(arguments.source, source_options(arguments))
+    output = Path(arguments.output) if arguments.output else Path("reports") / "replay" / source.name
+    knowledge = output / KNOWLEDGE_FILE
+    if arguments.source == "bag":  # a robot's run: what the anchoring node would have told the knowledge base
+        output.mkdir(parents=True, exist_ok=True)
+        knowledge.unlink(missing_ok=True)
+        overrides = {"knowledge_base": f"sqlite://{knowledge.resolve()}", **overrides}
     settings = source.anchoring_settings(*parameter_files, overrides=overrides, node=node)
     recorded = getattr(source, "uses_recorded_detections", False)
     detector = None if recorded else create_replay_detector(arguments.detector, arguments.score_threshold)
     service = AnchoringService(settings)
-    pipeline = ReplayPipeline(source, detector, create_replay_tracker(source, arguments.stride), service.anchoring)
-    output = Path(arguments.output) if arguments.output else Path("reports") / "replay" / source.name
+    pipeline = ReplayPipeline(source, detector, create_replay_tracker(source, arguments.stride), service.anchoring,
+                              lock=service.lock)
     options = ReplayOptions(
         output=output, frames=arguments.frames, stride=arguments.stride, first=arguments.first,
         image_every=arguments.every, video=not arguments.no_video,
@@ -110,9 +117,13 @@ def run(arguments: argparse.Namespace) -> int:
                 "parameter_files": [str(item) if isinstance(item, Path) else item for item in parameter_files],
                 "anchoring": parameter_values(settings)},
     )
-    report = run_replay(pipeline, options)
+    with service:  # a knowledge base, where one is written, gets its last sync when the replay ends
+        report = run_replay(pipeline, options)
     print()
     print(format_summary(report))
     print(f"wrote {len(report.files)} files to {output}/ (anchors.md, anchors.json, frames/"
-          + (", the video" if any(path.suffix in (".mp4", ".avi") for path in report.files) else "") + ")")
+          + (", the video" if any(path.suffix in (".mp4", ".avi") for path in report.files) else "")
+          + (f", {KNOWLEDGE_FILE}" if knowledge.is_file() else "") + ")")
+    if knowledge.is_file():
+        print(f"what the robot would know: sailor knowledge show --store sqlite://{knowledge}")
     return 130 if report.interrupted else 0

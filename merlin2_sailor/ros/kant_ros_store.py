@@ -12,7 +12,7 @@ and gives up after ``timeout`` seconds per request, raising KnowledgeError inste
 A thread left waiting on a node that died mid-call is abandoned: it holds nothing of the store's,
 and, a daemon, it does not keep the process from exiting.
 
-A read is tried up to READ_ATTEMPTS times within that deadline. Over DDS a service can be listed
+A read is asked again (READ_ATTEMPTS, READ_ATTEMPT_SECONDS) within that deadline. Over DDS a service can be listed
 before its answers can reach this client (the server's reply writer has not yet matched the
 client's reader): the request is served and the reply lost, and KANT's DAO then waits forever
 (measured in CI: a store opened on a node that had just started never got its first read). A read
@@ -22,6 +22,7 @@ asks again; a write is not repeated, since KANT would apply it twice.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
@@ -39,7 +40,9 @@ PROBE_SERVICE = "get_types"
 REQUESTS_PER_READ = 5
 """A reload asks KANT for each of its five kinds."""
 READ_ATTEMPTS = 3
-"""How many times a read is asked within its deadline before the store gives up."""
+"""A read is asked at least this many times within its deadline before the store gives up..."""
+READ_ATTEMPT_SECONDS = 10.0
+"""...and again every this many seconds at most (a lost reply never comes; KANT answers in milliseconds)."""
 
 Result = TypeVar("Result")
 
@@ -71,20 +74,25 @@ class KantRosStore(KantStore):
         return cls(namespace=location.removeprefix(SCHEME) or "/", timeout=timeout)
 
     def _load(self) -> list:
-        return self._with_deadline(super()._load, REQUESTS_PER_READ, attempts=READ_ATTEMPTS)
+        return self._with_deadline(super()._load, REQUESTS_PER_READ, retried=True)
 
     def _persist(self, events: Sequence[ChangeEvent]) -> None:
         # A save may first read what it refers to; allow two requests per change.
         self._with_deadline(lambda: super(KantRosStore, self)._persist(events), 2 * len(events) + 1)
 
-    def _with_deadline(self, exchange: Callable[[], Result], requests: int, attempts: int = 1) -> Result:
-        """Run ``exchange`` within ``timeout`` seconds per request, in up to ``attempts`` equal tries."""
+    def _with_deadline(self, exchange: Callable[[], Result], requests: int, retried: bool = False) -> Result:
+        """Run ``exchange`` within ``timeout`` seconds per request; a ``retried`` one (a read) is
+        asked again, in tries of READ_ATTEMPT_SECONDS at most, until that deadline."""
         deadline = self._timeout * requests
-        for _attempt in range(attempts):
-            answered, value = self._attempt(exchange, deadline / attempts)
+        ends = time.monotonic() + deadline
+        while True:
+            remaining = ends - time.monotonic()
+            if remaining <= 0:
+                raise KnowledgeError(f"KANT's knowledge base in {self._namespace} did not answer within {deadline:g} s")
+            answered, value = self._attempt(
+                exchange, min(remaining, READ_ATTEMPT_SECONDS, deadline / READ_ATTEMPTS) if retried else remaining)
             if answered:
                 return value
-        raise KnowledgeError(f"KANT's knowledge base in {self._namespace} did not answer within {deadline:g} s")
 
     def _attempt(self, exchange: Callable[[], Result], deadline: float) -> tuple[bool, Result | None]:
         """(True, result) if the exchange ended within ``deadline``, (False, None) if not; its error is raised."""

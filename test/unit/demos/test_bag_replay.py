@@ -14,6 +14,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 
 from merlin2_sailor.cli.main import main
 from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.knowledge import open_store
 from merlin2_sailor.ros.bags import BagReader
 from merlin2_sailor.ros.bags.message_definitions import jazzy_typestore
 
@@ -42,6 +43,9 @@ def test_a_bag_replays_to_one_anchor_per_object_with_its_recorded_detections(tmp
     depths = sorted(round(position[0], 1) for _, position in anchors.values())
     assert depths[0] == pytest.approx(2.0, abs=0.15) and depths[-1] == pytest.approx(3.0, abs=0.15)
     assert "rosbag2 bag" in capsys.readouterr().out
+    # What the anchoring node would have told the knowledge base, as a store of its own.
+    with open_store(f"sqlite://{tmp_path / 'replay' / 'knowledge.db'}") as knowledge:
+        assert set(anchors) <= {pddl_object.name for pddl_object in knowledge.objects.get_all()}
 
 
 def test_replays_of_one_scene_give_the_same_anchors_whatever_order_the_detections_came_in(tmp_path, capsys) -> None:
