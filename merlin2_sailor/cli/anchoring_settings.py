@@ -42,18 +42,7 @@ def parameter_sources(arguments: argparse.Namespace) -> tuple[list[Path | dict[s
     sources: list[Path | dict[str, Any]] = []
     node = f"/{ANCHORING_EXECUTABLE}"
     if arguments.launch:
-        from merlin2_sailor.launcher import load_launch_file
-        from merlin2_sailor.resources import find_launch_file
-
-        path = find_launch_file(arguments.launch)
-        nodes = [spec for spec in load_launch_file(path).nodes if spec.executable == ANCHORING_EXECUTABLE]
-        if len(nodes) != 1:
-            raise ConfigurationError(
-                f"--launch {arguments.launch}: {path} starts {len(nodes)} anchoring nodes; name a launch file "
-                "with exactly one")
-        spec = nodes[0]
-        sources += list(spec.parameters)
-        node = "/" + "/".join(part for part in (spec.namespace, spec.name or ANCHORING_EXECUTABLE) if part)
+        sources, node = launch_node_parameters(arguments.launch, ANCHORING_EXECUTABLE, "anchoring")
     for name in arguments.params:
         path = config_path(name, "anchoring.yaml")
         if not path.is_file():
@@ -62,6 +51,21 @@ def parameter_sources(arguments: argparse.Namespace) -> tuple[list[Path | dict[s
     if not sources:
         sources.append(config_file("anchoring.yaml"))
     return sources, node
+
+
+def launch_node_parameters(launch: str, executable: str, what: str) -> tuple[list[Path | dict[str, Any]], str]:
+    """What the launch file ``launch`` hands its one node of ``executable`` (its parameter files and
+    inline values, in order) and that node's fully qualified name; ``what`` names the node in errors."""
+    from merlin2_sailor.launcher import load_launch_file
+    from merlin2_sailor.resources import find_launch_file
+
+    path = find_launch_file(launch)
+    nodes = [spec for spec in load_launch_file(path).nodes if spec.executable == executable]
+    if len(nodes) != 1:
+        raise ConfigurationError(
+            f"--launch {launch}: {path} starts {len(nodes)} {what} nodes; name a launch file with exactly one")
+    spec = nodes[0]
+    return list(spec.parameters), "/" + "/".join(part for part in (spec.namespace, spec.name or executable) if part)
 
 
 def set_parameters(arguments: argparse.Namespace) -> dict[str, Any]:

@@ -4,7 +4,6 @@ generator's parameters, taken from the same files (or launch file) the node is s
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 from merlin2_sailor.errors import ConfigurationError
@@ -54,23 +53,13 @@ def percept_parameters(arguments: argparse.Namespace) -> dict[str, Any]:
     """The percept generator node's parameters: from --launch's percept_generator node (its files
     and inline values, in order) or config/percept_generator.yaml, then the --params files."""
     from merlin2_sailor.anchoring.settings import read_parameter_file
+    from merlin2_sailor.cli.anchoring_settings import launch_node_parameters
     from merlin2_sailor.resources import config_file, config_path
 
-    sources: list[Path | dict[str, Any]] = []
-    node = f"/{PERCEPT_EXECUTABLE}"
     if arguments.launch:
-        from merlin2_sailor.launcher import load_launch_file
-        from merlin2_sailor.resources import find_launch_file
-
-        path = find_launch_file(arguments.launch)
-        nodes = [spec for spec in load_launch_file(path).nodes if spec.executable == PERCEPT_EXECUTABLE]
-        if len(nodes) != 1:
-            raise ConfigurationError(f"--launch {arguments.launch}: {path} starts {len(nodes)} percept generator "
-                                     "nodes; name a launch file with exactly one")
-        sources += list(nodes[0].parameters)
-        node = "/" + "/".join(part for part in (nodes[0].namespace, nodes[0].name or PERCEPT_EXECUTABLE) if part)
+        sources, node = launch_node_parameters(arguments.launch, PERCEPT_EXECUTABLE, "percept generator")
     else:
-        sources.append(config_file("percept_generator.yaml"))
+        sources, node = [config_file("percept_generator.yaml")], f"/{PERCEPT_EXECUTABLE}"
     sources += [config_path(name, "percept_generator.yaml") for name in arguments.params]
     values: dict[str, Any] = {}
     for source in sources:

@@ -139,3 +139,17 @@ def test_frames_of_an_unusable_encoding_are_skipped_with_one_line(tmp_path, caps
 def test_the_reader_refuses_a_path_that_is_not_there(tmp_path) -> None:
     with pytest.raises(ConfigurationError, match="no bag"):
         BagReader(tmp_path / "absent")
+
+
+def test_the_percept_generators_parameters_come_from_the_launch_file_as_the_node_gets_them(tmp_path) -> None:
+    import argparse
+
+    from merlin2_sailor.cli.bag_replay_options import percept_parameters
+    from merlin2_sailor_demos.replay.bag_source import BagSource, BagSourceConfig
+
+    launched = percept_parameters(argparse.Namespace(launch="house", params=[]))
+    assert launched["maximum_depth"] == 4.5 and launched["world_frame"] == "map"  # inline, then the file's
+    assert percept_parameters(argparse.Namespace(launch="", params=[]))["maximum_depth"] == 20.0
+    source = BagSource(BagSourceConfig(data=str(write_bag(tmp_path / "bag", Scene(frames=2))),
+                                       percept_parameters={**launched, "slop": 0.01}))
+    assert source.percept_config().box3d.maximum_depth == 4.5 and source.slop == 0.01
