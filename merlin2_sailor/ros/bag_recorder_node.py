@@ -13,12 +13,12 @@ holds. A topic whose type has no installed definition is said once and left out.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.ros.bags import BAG_STORAGES, BagWriter
 from merlin2_sailor.ros.conversions import message_class
 from merlin2_sailor.ros.node_runner import run_node
@@ -37,15 +37,15 @@ QUEUE_DEPTH = 100  # messages a subscription holds while the writer is busy (a b
 class BagRecorderNode(Node):
     def __init__(self) -> None:
         super().__init__(NODE_NAME)
-        path = declare_parameter(self, "path", "", "Folder of the bag to create (it must not exist).")
+        path = declare_parameter(self, "path", "", "Folder of the bag to create (it must not exist); empty: "
+                                 "rosbag2_<date>-<time> in the working directory, as ros2 bag names it.")
         storage = declare_parameter(self, "storage", "mcap", f"Bag storage: {' or '.join(BAG_STORAGES)}.")
         topics = declare_parameter(self, "topics", list(DEFAULT_TOPICS),
                                    "Topics to record, as they appear (absolute, or relative to the namespace).")
         discovery_period = declare_parameter(self, "discovery_period", 0.5,
                                              "Seconds between two looks for listed topics not yet recorded.",
                                              minimum=0.05, maximum=60.0)
-        if not path:
-            raise ConfigurationError("bag_recorder needs a path: -p path:=FOLDER (a new folder for the bag)")
+        path = path or time.strftime("rosbag2_%Y_%m_%d-%H_%M_%S")
         self._wanted = [self.resolve_topic_name(topic) for topic in topics if topic]
         self._writer = BagWriter(path, storage)
         self._subscribed: set[str] = set()

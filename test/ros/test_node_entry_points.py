@@ -11,6 +11,8 @@ from importlib.metadata import distribution
 import pytest
 
 TOOLS = {"sailor"}
+#: What a node writes goes into the test's folder, not the working directory.
+OUTPUT_PARAMETERS = {"bag_recorder": "path:={folder}/bag"}
 NODE_EXECUTABLES = sorted(
     entry.name for entry in distribution("merlin2_sailor").entry_points
     if entry.group == "console_scripts" and entry.name not in TOOLS
@@ -23,9 +25,10 @@ def test_the_package_installs_nodes() -> None:
 
 @pytest.mark.ros
 @pytest.mark.parametrize("executable", NODE_EXECUTABLES)
-def test_node_starts_joins_the_graph_and_shuts_down_cleanly(executable, ros_probe, node_process) -> None:
+def test_node_starts_joins_the_graph_and_shuts_down_cleanly(executable, ros_probe, node_process, tmp_path) -> None:
     node_name = f"entry_point_test_{executable}"
-    process = node_process(executable, "--ros-args", "-r", f"__node:={node_name}")
+    output = ["-p", OUTPUT_PARAMETERS[executable].format(folder=tmp_path)] if executable in OUTPUT_PARAMETERS else []
+    process = node_process(executable, "--ros-args", "-r", f"__node:={node_name}", *output)
     joined = ros_probe.wait_for_node(f"/{node_name}")
     exit_code = process.stop()
     assert joined, f"{executable} never appeared in the graph; its output:\n{process.text}"
