@@ -68,6 +68,7 @@ class PipelineConfig:
     #: Anchoring and detector parameters over the shipped configuration (e.g. the matcher, the runtime).
     anchoring_parameters: tuple[tuple[str, object], ...] = ()
     detector_parameters: tuple[tuple[str, object], ...] = ()
+    percept_parameters: tuple[tuple[str, object], ...] = ()
 
     @property
     def node_labels(self) -> tuple[str, ...]:
@@ -273,7 +274,8 @@ def launch_spec(config: PipelineConfig, folder: Path, frames_file: Path) -> Laun
             {"state_folder": str(folder / "anchoring"), "knowledge_base": f"ros:///{namespace}/merlin2",
              **dict(config.anchoring_parameters)})),
         NodeSpec("percept_generator", namespace=namespace, parameters=(
-            config_file("percept_generator.yaml"), {"report_period": config.report_period})),
+            config_file("percept_generator.yaml"),
+            {"report_period": config.report_period, **dict(config.percept_parameters)})),
         # By name, so the launcher finds this venv's interpreter (a path would be resolved past its symlink).
         NodeSpec(Path(sys.executable).name, name=PLAYER_LABEL, namespace=namespace, arguments=tuple(player_arguments)),
     )

@@ -190,6 +190,10 @@ class PerceptNode(Node):
         )
         id_prefix = declare_parameter(self, "tracker_id_prefix", "",
                                       "Prefix of tracker ids, to keep several cameras' ids apart.")
+        new_track_threshold = declare_parameter(
+            self, "tracker_new_track_threshold", ByteTrackConfig().new_track_threshold,
+            "Score from which an unmatched detection starts a track; at most the detector's score_threshold.",
+            minimum=0.0, maximum=1.0)
         self._tracker_config: ByteTrackConfig | None = None
         self._tracker: ByteTrackAdapter | None = None
         self._tracker_rate_known = frame_rate > 0.0
@@ -197,7 +201,8 @@ class PerceptNode(Node):
         if tracker == "bytetrack":
             # Built now even when the rate is still unknown, so a missing package or a bad threshold
             # stops the node at start-up rather than at the first detection.
-            self._tracker_config = ByteTrackConfig(frame_rate=frame_rate or 30.0, id_prefix=id_prefix)
+            self._tracker_config = ByteTrackConfig(frame_rate=frame_rate or 30.0, id_prefix=id_prefix,
+                                                   new_track_threshold=new_track_threshold)
             self._tracker = ByteTrackAdapter(self._tracker_config)
         return tracker
 
