@@ -43,11 +43,9 @@ from merlin2_sailor.ros.conversions import (
     transform_to_pose,
 )
 from merlin2_sailor.ros.conversions.detection_sources import DETECTION_TYPES, detection_source
+from merlin2_sailor.ros.percept_node import DEFAULT_SLOP_SECONDS, FORWARD_OPTICAL_EXTRINSICS
 from merlin2_sailor_demos.replay.source import ReplayFrame, ReplaySource
 
-#: The percept generator node's pairing tolerance and Odometry extrinsics, when no file sets them.
-DEFAULT_SLOP_SECONDS = 0.03
-FORWARD_OPTICAL_EXTRINSICS = (0.0, 0.0, 0.0, -0.5, 0.5, -0.5, 0.5)
 TF_TOPIC, TF_STATIC_TOPIC = "/tf", "/tf_static"
 #: Detection message type in a bag -> the percept generator's detections_type.
 DETECTIONS_TYPE_OF_MESSAGE = {
@@ -109,14 +107,13 @@ class BagSource(ReplaySource):
         self._said: set[str] = set()
         self._bag = BagReader(config.data)
         with self._bag as bag:
-            self._topics = dict(bag.topics)
             self._plans = self._plan_frames(bag)
         if not self._plans:
             reasons = ", ".join(f"{count} {reason}" for reason, count in self.skipped.items()) or "no colour images"
             raise ConfigurationError(f"the bag {config.data} has no frame to replay ({reasons})")
-        stamps = np.array([plan.color_ns for plan in self._plans], dtype=np.float64) / 1e9
-        if len(stamps) > 1 and np.median(np.diff(stamps)) > 0:
-            self.frame_rate = float(1.0 / np.median(np.diff(stamps)))
+        period = float(np.median(np.diff([plan.color_ns for plan in self._plans]))) / 1e9 if len(self._plans) > 1 else 0
+        if period > 0:
+            self.frame_rate = 1.0 / period
         self.default_frames = len(self._plans)
 
     # --- ReplaySource ---------------------------------------------------------------------------

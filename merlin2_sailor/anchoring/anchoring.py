@@ -204,8 +204,10 @@ class Anchoring:
         # New anchors of one class in one frame take their symbols in the order of their places, not
         # of the detector's list (which a detector may shuffle): the same frames give the same
         # symbols, live or replayed from a bag, whichever order the detections came in.
-        first_of_class = {percepts[row].class_name: order for order, row in reversed(list(enumerate(unmatched)))}
-        unmatched.sort(key=lambda row: (first_of_class[percepts[row].class_name], *map(float, percepts[row].position)))
+        class_order: dict[str, int] = {}
+        for row in unmatched:
+            class_order.setdefault(percepts[row].class_name, len(class_order))
+        unmatched.sort(key=lambda row: (class_order[percepts[row].class_name], *map(float, percepts[row].position)))
         for row in unmatched:
             anchor = acquire(self._fresh_symbol(percepts[row].class_name), percepts[row], changes, config.fusion,
                              config.lifecycle, partial=partial[row])

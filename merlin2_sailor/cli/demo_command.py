@@ -119,7 +119,6 @@ def run(arguments: argparse.Namespace) -> int:
         return run_scenarios(arguments)
     if arguments.seeds is not None:
         raise ConfigurationError("--seeds runs scenarios: give --scenario NAME or --all-scenarios too")
-
     return run_default(arguments)
 
 

@@ -7,6 +7,7 @@ starts, so a bag that would be written over is one clear error instead of a laun
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 from pathlib import Path
 
@@ -32,7 +33,7 @@ def with_recorder(spec: LaunchSpec, folder: str | Path, storage: str = "mcap") -
     return dataclasses.replace(spec, nodes=(*spec.nodes, recorder))
 
 
-def add_record_arguments(parser) -> None:  # noqa: ANN001 - an argparse parser
+def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--record", default="", metavar="FOLDER",
                         help="also record the camera, percepts, anchors and knowledge changes to a rosbag2 bag "
                              "in FOLDER (new); replay it with `sailor replay bag FOLDER`, open it in Foxglove")

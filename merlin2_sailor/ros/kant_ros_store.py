@@ -12,11 +12,11 @@ and gives up after ``timeout`` seconds per request, raising KnowledgeError inste
 A thread left waiting on a node that died mid-call is abandoned: it holds nothing of the store's,
 and, a daemon, it does not keep the process from exiting.
 
-A read is asked again (READ_ATTEMPTS, READ_ATTEMPT_SECONDS) within that deadline. Over DDS a service can be listed
-before its answers can reach this client (the server's reply writer has not yet matched the
-client's reader): the request is served and the reply lost, and KANT's DAO then waits forever
-(measured in CI: a store opened on a node that had just started never got its first read). A read
-asks again; a write is not repeated, since KANT would apply it twice.
+Over DDS a service can be listed before its answers can reach this client (the server's reply
+writer has not yet matched the client's reader): the request is served, the reply is lost, and
+KANT's DAO waits forever (measured in CI: a store opened on a node that had just started never
+got its first read). So a read is asked again within its deadline (READ_ATTEMPTS,
+READ_ATTEMPT_SECONDS); a write is not repeated, since KANT would apply it twice.
 """
 
 from __future__ import annotations

@@ -88,6 +88,8 @@ FUTURE_STAMP_LIMIT_SECONDS = 10.0
 RATE_ESTIMATION_FRAMES = 5
 #: The optical frame at the robot base's origin looking forward: REP 103 base (x forward, z up).
 FORWARD_OPTICAL_EXTRINSICS = [0.0, 0.0, 0.0, -0.5, 0.5, -0.5, 0.5]
+DEFAULT_SLOP_SECONDS = 0.03
+"""Largest stamp spread of a synchronised frame when no parameter file sets ``slop``."""
 
 DEPTH_SOURCES = ("depth_image", "point_cloud")
 POSE_SOURCES = ("topic", "tf")
@@ -122,8 +124,8 @@ class PerceptNode(Node):
             self, "camera_extrinsics", FORWARD_OPTICAL_EXTRINSICS,
             "Odometry only: pose of the camera optical frame in the robot base frame, [x, y, z, qx, qy, qz, qw].",
         )
-        slop = declare_parameter(self, "slop", 0.03, "Largest stamp spread (s) of a synchronised frame.",
-                                 minimum=0.0, maximum=1.0)
+        slop = declare_parameter(self, "slop", DEFAULT_SLOP_SECONDS,
+                                 "Largest stamp spread (s) of a synchronised frame.", minimum=0.0, maximum=1.0)
         queue_size = declare_parameter(
             self, "sync_queue_size", 15,
             "Messages kept per input while waiting for a match; must cover the detector's latency.",

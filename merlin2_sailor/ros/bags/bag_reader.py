@@ -40,7 +40,6 @@ class BagReader:
             raise ConfigurationError(f"no bag at {self.path}")
         self._reader: Reader | None = None
         self.topics: dict[str, str] = {}
-        self.counts: dict[str, int] = {}
 
     def __enter__(self) -> BagReader:
         try:
@@ -57,7 +56,6 @@ class BagReader:
         self._reader = reader
         for connection in reader.connections:
             self.topics[connection.topic] = connection.msgtype
-            self.counts[connection.topic] = self.counts.get(connection.topic, 0) + connection.msgcount
         return self
 
     def __exit__(self, *_exception: object) -> None:
@@ -67,10 +65,6 @@ class BagReader:
             except (ReaderError, OSError):
                 pass
             self._reader = None
-
-    @property
-    def duration_seconds(self) -> float:
-        return self._open().duration / 1e9
 
     def require(self, topic: str, what: str, option: str) -> str:
         """The type of ``topic``; a clear error naming the bag's topics when it is not there."""

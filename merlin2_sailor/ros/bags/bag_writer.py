@@ -45,10 +45,6 @@ class BagWriter:
         self._connections: dict[str, Connection] = {}
         self.counts: dict[str, int] = {}
 
-    @property
-    def topics(self) -> dict[str, str]:
-        return {topic: connection.msgtype for topic, connection in self._connections.items()}
-
     def add_topic(self, topic: str, type_name: str) -> None:
         """Record ``topic`` of ``type_name`` (``package/msg/Type``); its definition must be installed."""
         if topic in self._connections:
@@ -60,10 +56,6 @@ class BagWriter:
     def write(self, topic: str, recorded_ns: int, data: bytes) -> None:
         self._writer.write(self._connections[topic], recorded_ns, data)
         self.counts[topic] += 1
-
-    def set_description(self, key: str, value: str) -> None:
-        """A text kept in the bag's metadata (custom_data), such as the nodes' parameters."""
-        self._writer.set_custom_data(key, value)
 
     def close(self) -> None:
         self._writer.close()
