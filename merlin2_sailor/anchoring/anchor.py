@@ -92,6 +92,9 @@ class Anchor:
     """While MISSING: the symbols of anchors that a search found and could not tell from this one
     (look-alikes, each as likely to be it); empty when its identity is decided. The finder reports
     it instead of guessing, so a planner learns "not found: cannot tell which" rather than a lie."""
+    watched_before: int = 0
+    """Frames in which the camera had watched its place, with no unknown object of its class there,
+    before it was first seen (:mod:`.watched_places`): many means it arrived there since, moved."""
 
     @property
     def confidence(self) -> float:

@@ -46,6 +46,7 @@ from merlin2_sailor.anchoring.snapshot import anchors_of_snapshot, snapshot_of
 from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
 from merlin2_sailor.anchoring.unseen import check_unseen, forget_expired
 from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig
+from merlin2_sailor.anchoring.watched_places import WatchConfig, WatchedPlaces
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
@@ -67,7 +68,8 @@ class AnchoringConfig:
     confirm the expectation (farther retracts it), also added to a search's radius;
     ``repair``: when a newer anchor is a lost one seen again (:mod:`.identity_repair`);
     ``colour``: when colours rule out that a view or an anchor is another anchor's object
-    (:mod:`.colour_evidence`), in the matching table and in every merge.
+    (:mod:`.colour_evidence`), in the matching table and in every merge; ``watch``: where the
+    camera has watched, so that an object first seen there arrived (:mod:`.watched_places`).
     """
 
     match_threshold: float = 0.5
@@ -80,6 +82,7 @@ class AnchoringConfig:
     partial_view: PartialViewConfig = field(default_factory=PartialViewConfig)
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
     visibility: VisibilityConfig = field(default_factory=VisibilityConfig)
+    watch: WatchConfig = field(default_factory=WatchConfig)
     index: IndexConfig = field(default_factory=IndexConfig)
 
     def __post_init__(self) -> None:
@@ -129,8 +132,9 @@ class Anchoring:
         self._table_builder = MatchingTableBuilder(self.matcher, self.config.table, embedder, self.config.colour)
         self._repair = IdentityRepair(
             self.matcher, self.config.match_threshold, self.config.repair, self.config.expectation_tolerance,
-            self.config.colour,
+            self.config.colour, self.config.watch.frames_to_arrive,
         )
+        self._watched = WatchedPlaces(self.config.watch, self.config.visibility)
         self._index = AnchorIndex(self.config.index)
         self._latest_stamp = -math.inf
 
@@ -191,9 +195,11 @@ class Anchoring:
         percepts = table.percepts
         assignment = assign(table.scores, self.config.match_threshold)
         symbols = [""] * len(percepts)
+        unknown = [True] * len(percepts)  # percepts no trusted anchor explains, for the watched places
         config = self.config
         for row, column in assignment.matches:
             anchor = table.anchors[column]
+            unknown[row] = anchor.state is AnchorState.TENTATIVE
             reacquire(anchor, percepts[row], changes, config.fusion, config.lifecycle, config.expectation_tolerance,
                       continued=bool(table.continuations[row, column]), partial=partial[row])
             self._index.refresh(anchor)
@@ -211,9 +217,11 @@ class Anchoring:
         for row in unmatched:
             anchor = acquire(self._fresh_symbol(percepts[row].class_name), percepts[row], changes, config.fusion,
                              config.lifecycle, partial=partial[row])
+            anchor.watched_before = self._watched.watched_without(anchor.position, anchor.class_name)
             self._index.add(anchor)
             symbols[row] = anchor.symbol
 
+        self._watched.watch(percepts, unknown, camera)
         seen = set(symbols)
         if camera is not None:
             check_unseen(self._index, camera, seen, changes, config.visibility, config.lifecycle)
@@ -340,6 +348,14 @@ class Anchoring:
     def _repair_identities(self, changes: FrameChanges) -> dict[str, str]:
         """Apply identity repair after a frame; return {merged symbol: kept symbol}."""
         decisions = self._repair.decide_reappearances(changes.missing, changes.confirmed_newcomers, self._index)
+        # An arrival is judged when it is confirmed and again when its colour becomes known (a
+        # relocation needs both colours), whichever comes last.
+        colour_known = [
+            anchor for anchor in changes.reacquired
+            if anchor.colour is not None and anchor.colour.views == self.config.colour.minimum_views
+        ]
+        decisions.extend(self._repair.decide_relocations(
+            changes.missing, [*changes.confirmed_newcomers, *colour_known], self._index))
         if changes.confirmed_newcomers:  # something new may be what a running search looks for
             for sought in self._index.expected():
                 if sought.expectation is not None and sought.expectation.is_search:

@@ -165,6 +165,17 @@ def colours_differ(first: ColourModel | None, second: ColourModel | None, config
     return colour_difference(first, second, config) > 0.0
 
 
+def colours_agree(first: ColourModel | None, second: ColourModel | None, config: ColourEvidenceConfig) -> bool:
+    """Whether both anchors know their colour (``minimum_views`` whole views each) and the colours
+    do not differ: evidence *for* one object, as a relocation merge needs (not knowing is no
+    evidence either way)."""
+    if config.minimum_views == 0 or first is None or second is None:
+        return False
+    if first.views < config.minimum_views or second.views < config.minimum_views:
+        return False
+    return not colours_differ(first, second, config)
+
+
 def view_differs(model: ColourModel | None, histogram: np.ndarray | None, config: ColourEvidenceConfig) -> bool:
     """Whether one whole view's colour shows it is not the anchor's object."""
     return histogram is not None and colours_differ(model, ColourModel.of(histogram), config)

@@ -9,6 +9,10 @@ under two symbols unless repaired:
 - **a reappearance**: a MISSING anchor's object comes back where it was lost, but another percept
   of its class (a false detection with a large box, the near end of a bicycle) took the old
   anchor in that very frame, so the real object became a newcomer.
+- **a relocation**: the object was moved while the camera looked away, to a place the camera had
+  watched before (:mod:`.watched_places`), so its new anchor *arrived* there; no search is
+  needed when the colours agree and nothing else could be it (the green mug of a swap, put where
+  the red one stood, whose old place is seen empty later).
 
 Every decision here is pure: it reads anchors and the anchor index and returns a :class:`Merge`
 (``merged`` was ``kept`` all along), an :class:`Undecided` (the evidence cannot tell which of
@@ -20,7 +24,9 @@ score at or above the match threshold, a candidate must be possible at all:
 
 - same class, nothing expected of it, trusted (confirmed, or confirmed once and missing again);
 - born no earlier than the lost anchor's last sighting before it went missing: two anchors seen
-  side by side at one time are two objects, whatever they look like;
+  side by side at one time are two objects, whatever they look like (for an anchor *disputed* by
+  a view of another colour in its place, its last sighting with its own colour: the colourless
+  sightings after it may have been of the other object);
 - not of another colour: the colours of the two anchors' own pixels do not rule it out
   (:mod:`.colour_evidence`; the rules have no other appearance, and the learned matcher's is
   fooled by a look-alike where the lost one stood). A mug of another colour found where the red
@@ -44,7 +50,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_agree, colours_differ
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.matcher import Matcher
@@ -104,13 +110,16 @@ class IdentityRepair:
     colour evidence configuration."""
 
     def __init__(self, matcher: Matcher, match_threshold: float, config: RepairConfig, search_tolerance: float,
-                 colour: ColourEvidenceConfig | None = None) -> None:
+                 colour: ColourEvidenceConfig | None = None, arrival_frames: int = 0) -> None:
         self.matcher = matcher
         self.colour = colour or ColourEvidenceConfig()
         self.match_threshold = match_threshold
         self.config = config
         self.search_tolerance = search_tolerance
         """Metres added to a search's radius: an object at its edge, measured with noise, is in."""
+        self.arrival_frames = arrival_frames
+        """Frames a place must have been watched for an object first seen there to have arrived
+        (:mod:`.watched_places`); 0: relocation merges off."""
 
     # --- searches ---------------------------------------------------------------------------
 
@@ -164,6 +173,89 @@ class IdentityRepair:
                 decisions.append(decision)
         return decisions
 
+    # --- relocations ------------------------------------------------------------------------
+
+    def decide_relocations(
+        self, lost: Iterable[Anchor], newcomers: Iterable[Anchor], index: AnchorIndex
+    ) -> list[Merge]:
+        """Merges of MISSING anchors with confirmed anchors that *arrived* elsewhere since (moved
+        while the camera looked away), without a search.
+
+        ``lost``: anchors that went missing this frame; ``newcomers``: anchors confirmed for the
+        first time this frame. Stricter than a search, which knows where the mission looks: the
+        newer anchor must stand where the camera had watched for ``arrival_frames`` frames with no
+        unknown object of its class (:mod:`.watched_places`), so it was not there all along; both
+        anchors' colours must be known and agree; no anchor near it may be what it is a duplicate
+        of; and the match must be clear both ways. Where any of that fails nothing is decided (a
+        search, with its own evidence, may still find the object): a case that cannot be told
+        apart is left to the search rather than reported here.
+        """
+        if self.arrival_frames <= 0:
+            return []
+        in_question = {anchor.symbol: anchor for anchor in lost}
+        for newcomer in newcomers:
+            if self._arrived(newcomer):
+                for anchor in index.of_class(newcomer.class_name):
+                    if anchor.state is AnchorState.MISSING:
+                        in_question.setdefault(anchor.symbol, anchor)
+        merges: list[Merge] = []
+        taken: set[str] = set()
+        for symbol in sorted(in_question):
+            missing = in_question[symbol]
+            if missing.state is not AnchorState.MISSING or missing.expectation is not None:
+                continue
+            near = {anchor.symbol for anchor in self._near(missing, index)}
+            candidates = [
+                anchor for anchor in index.of_class(missing.class_name)
+                if anchor.symbol not in taken and anchor.symbol not in near
+                and self._relocation_possible(anchor, missing) and not self._may_duplicate(anchor, missing, index)
+            ]
+            merge = self._decide_relocation(missing, candidates, index)
+            if merge is not None:
+                taken.add(merge.merged.symbol)
+                merges.append(merge)
+        return merges
+
+    def _decide_relocation(self, lost: Anchor, candidates: Sequence[Anchor], index: AnchorIndex) -> Merge | None:
+        if not candidates:
+            return None
+        scores = np.array([self._score_anywhere(candidate, lost) for candidate in candidates])
+        best = int(np.argmax(scores))
+        if scores[best] < self.match_threshold:
+            return None
+        if any(scores[k] > scores[best] - self.config.ambiguity_margin for k in range(len(candidates)) if k != best):
+            return None
+        chosen = candidates[best]
+        for rival in index.of_class(chosen.class_name):
+            if (rival is not lost and rival.state is AnchorState.MISSING and rival.expectation is None
+                    and self._relocation_possible(chosen, rival)
+                    and self._score_anywhere(chosen, rival) > scores[best] - self.config.ambiguity_margin):
+                return None
+        return Merge(lost, chosen, float(scores[best]), "moved: it appeared where the camera had watched", True)
+
+    def _score_anywhere(self, candidate: Anchor, lost: Anchor) -> float:
+        """The matching function's score with place left out (the lost anchor could be anywhere)."""
+        return float(identity_scores(self.matcher, [candidate], lost, SearchedDisc(candidate.position, 0.0))[0])
+
+    def _arrived(self, anchor: Anchor) -> bool:
+        return anchor.watched_before >= self.arrival_frames
+
+    def _relocation_possible(self, candidate: Anchor, lost: Anchor) -> bool:
+        return (
+            self._arrived(candidate)
+            and self._possible(candidate, lost, include_missing=False)
+            and colours_agree(candidate.colour, lost.colour, self.colour)
+        )
+
+    def _may_duplicate(self, candidate: Anchor, lost: Anchor, index: AnchorIndex) -> bool:
+        """Whether an older anchor near ``candidate``, not of another colour, may be its object (a
+        second anchor of an object seen there all along, after a percept slid off its first)."""
+        return any(
+            other is not lost and other.class_name == candidate.class_name and other.first_seen < candidate.first_seen
+            and not colours_differ(other.colour, candidate.colour, self.colour)
+            for other in self._near(candidate, index)
+        )
+
     # --- shared -----------------------------------------------------------------------------
 
     def _decide(
@@ -216,6 +308,10 @@ class IdentityRepair:
         """Whether ``candidate`` can be ``lost`` at all (before any score): see the module docstring."""
         allowed = (AnchorState.CONFIRMED, AnchorState.MISSING) if include_missing else (AnchorState.CONFIRMED,)
         last_sighting = lost.lost_after if lost.lost_after is not None else lost.last_seen
+        if lost.colour_disputed and lost.colour_seen is not None:
+            # A view of another colour stood in its place: its later sightings without a colour
+            # (far, cut off) may have been of that other object, so only its own colour counts.
+            last_sighting = min(last_sighting, lost.colour_seen)
         return (
             candidate is not lost
             and candidate.class_name == lost.class_name

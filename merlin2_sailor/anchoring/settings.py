@@ -340,6 +340,15 @@ SETTINGS: tuple[Setting, ...] = (
                 "How much better than every rival a candidate for a merge must score to be taken (scores "
                 "closer than this cannot tell two look-alikes apart: nothing is merged, and it is said).",
                 0.0, 0.99),
+        Setting("relocation_watched_frames", ("core", "watch", "frames_to_arrive"),
+                "Frames the camera must have watched a place, with no unknown object of a class in it, for an "
+                "object of that class first seen there to count as having arrived (moved): only such an object "
+                "is merged into a missing anchor of its colour without a search (0 turns that off).", 0, 100000),
+        Setting("watch_cell", ("core", "watch", "cell"),
+                "Side (m) of the floor-plan cells in which the camera's watching is counted.", 0.01, 10.0),
+        Setting("watch_radius", ("core", "watch", "radius"),
+                "How far (m) around each percept the camera counts as watching (the detector worked there).",
+                0.0, 10.0),
         Setting("colour_minimum_views", ("core", "colour", "minimum_views"),
                 "Whole views an anchor needs before its colour (of the object's own pixels) is known; one of "
                 "two anchors compared must know it before colours may rule out that they are one object "

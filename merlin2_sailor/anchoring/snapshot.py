@@ -65,6 +65,7 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "expectation": None if anchor.expectation is None else anchor.expectation.describe(),
         "expectation_confirmed": bool(anchor.expectation_confirmed),
         "indistinguishable_from": list(anchor.indistinguishable_from),
+        "watched_before": int(anchor.watched_before),
     }
 
 
@@ -98,6 +99,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             expectation=None if data.get("expectation") is None else Expectation.from_description(data["expectation"]),
             expectation_confirmed=bool(data.get("expectation_confirmed", False)),
             indistinguishable_from=tuple(str(symbol) for symbol in data.get("indistinguishable_from") or ()),
+            watched_before=int(data.get("watched_before", 0)),
         )
     except (KeyError, ValueError, TypeError) as error:
         name = data.get("symbol", "?") if isinstance(data, Mapping) else "?"

@@ -13,6 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from merlin2_sailor.anchoring.features import FeatureConfig, PairFeatures
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
@@ -148,3 +151,23 @@ TWIN_MUGS = (
     SceneObject("left_mug", "cup", (2.5, 0.5, 0.8)),
     SceneObject("right_mug", "cup", (2.5, -0.5, 0.8), looks_like="left_mug"),
 )
+
+
+class AppearanceRules(Matcher):
+    """Rules times appearance: 1 for the same look, near 0 for another (unit embeddings)."""
+
+    uses_appearance = True
+
+    def __init__(self) -> None:
+        self.rules = RuleMatcher()
+
+    @property
+    def feature_config(self) -> FeatureConfig:
+        return self.rules.feature_config
+
+    def score_pairs(self, features: PairFeatures) -> np.ndarray:
+        scores = self.rules.score_pairs(features)
+        known = features.appearance_known
+        likeness = np.ones(len(features))
+        likeness[known] = np.exp(-((features.appearance_distance[known] / 2.0) ** 2) * 4.0)
+        return scores * likeness

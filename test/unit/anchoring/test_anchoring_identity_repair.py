@@ -17,38 +17,16 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
-from merlin2_sailor.anchoring.features import FeatureConfig, PairFeatures
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
-from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 
-from .anchoring_scenes import PerceptMaker, SceneObject, camera_view
+from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, camera_view
 
 FRAME = 1.0 / 15.0
 KITCHEN_MUG = SceneObject("blue_mug", "cup", (2.0, 0.3, 0.8))
 TWIN = SceneObject("blue_twin", "cup", (2.0, -0.3, 0.8), looks_like="blue_mug")
 LIVING_ROOM = np.array((1.5, 6.0, 0.8))
 GREEN_MUG = SceneObject("green_mug", "cup", (1.9, 6.2, 0.8))
-
-
-class AppearanceRules(Matcher):
-    """Rules times appearance: 1 for the same look, near 0 for another (unit embeddings)."""
-
-    uses_appearance = True
-
-    def __init__(self) -> None:
-        self.rules = RuleMatcher()
-
-    @property
-    def feature_config(self) -> FeatureConfig:
-        return self.rules.feature_config
-
-    def score_pairs(self, features: PairFeatures) -> np.ndarray:
-        scores = self.rules.score_pairs(features)
-        known = features.appearance_known
-        likeness = np.ones(len(features))
-        likeness[known] = np.exp(-((features.appearance_distance[known] / 2.0) ** 2) * 4.0)
-        return scores * likeness
 
 
 @pytest.fixture
