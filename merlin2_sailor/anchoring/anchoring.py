@@ -33,7 +33,7 @@ from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.identity_repair import IdentityRepair, Merge, RepairConfig
+from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.matching_table import Embedder, MatchingTableBuilder, MatchingTableConfig, with_embeddings
@@ -42,6 +42,7 @@ from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reac
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+from merlin2_sailor.anchoring.same_space import Duplicate, decide_same_space
 from merlin2_sailor.anchoring.snapshot import anchors_of_snapshot, snapshot_of
 from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
 from merlin2_sailor.anchoring.unseen import check_unseen, forget_expired
@@ -347,7 +348,8 @@ class Anchoring:
 
     def _repair_identities(self, changes: FrameChanges) -> dict[str, str]:
         """Apply identity repair after a frame; return {merged symbol: kept symbol}."""
-        decisions = self._repair.decide_reappearances(changes.missing, changes.confirmed_newcomers, self._index)
+        decisions: list[Decision | Duplicate | None] = list(
+            self._repair.decide_reappearances(changes.missing, changes.confirmed_newcomers, self._index))
         # An arrival is judged when it is confirmed and again when its colour becomes known (a
         # relocation needs both colours), whichever comes last.
         colour_known = [
@@ -356,15 +358,18 @@ class Anchoring:
         ]
         decisions.extend(self._repair.decide_relocations(
             changes.missing, [*changes.confirmed_newcomers, *colour_known], self._index))
+        decisions.extend(decide_same_space(changes.reacquired, self._index, self.config.repair.same_space_overlap,
+                                           self.config.colour))
         if changes.confirmed_newcomers:  # something new may be what a running search looks for
             for sought in self._index.expected():
                 if sought.expectation is not None and sought.expectation.is_search:
                     decisions.append(self._repair.decide_search(sought, sought.expectation, self._index))
         renamed: dict[str, str] = {}
         for decision in decisions:
-            if isinstance(decision, Merge) and not (decision.merged.symbol in self._index
-                                                    and decision.kept.symbol in self._index):
-                continue  # an earlier decision of this frame already merged one of them
+            involved = (decision.kept, decision.merged) if isinstance(decision, Merge) else (
+                (decision.kept, decision.duplicate) if isinstance(decision, Duplicate) else ())
+            if any(anchor.symbol not in self._index for anchor in involved):
+                continue  # an earlier decision of this frame already merged or forgot one of them
             apply_decision(decision, self._index, changes, self.config.fusion)
             if isinstance(decision, Merge):
                 renamed[decision.merged.symbol] = decision.kept.symbol

@@ -14,6 +14,8 @@ under two symbols unless repaired:
   needed when the colours agree and nothing else could be it (the green mug of a swap, put where
   the red one stood, whose old place is seen empty later).
 
+(A fourth case, a slip's second anchor in the very space of the first, is :mod:`.same_space`'s.)
+
 Every decision here is pure: it reads anchors and the anchor index and returns a :class:`Merge`
 (``merged`` was ``kept`` all along), an :class:`Undecided` (the evidence cannot tell which of
 several anchors it is), or nothing. The coordinator (:class:`~.anchoring.Anchoring`) applies them.
@@ -62,10 +64,13 @@ class RepairConfig:
     """``reappearance_distance`` (m): how close to a MISSING anchor a newcomer of its class must
     be confirmed to be considered as it reappearing (below the 0.3 m between books on a shelf;
     0 turns reappearance merges off); ``ambiguity_margin``: how much better than every rival a
-    candidate must score to be taken (scores closer than this cannot tell the two apart)."""
+    candidate must score to be taken (scores closer than this cannot tell the two apart);
+    ``same_space_overlap``: the share of the smaller 3D box two anchors of a class must have in
+    common to be one object (:mod:`.same_space`; 0 turns that off)."""
 
     reappearance_distance: float = 0.25
     ambiguity_margin: float = 0.15
+    same_space_overlap: float = 0.5
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.reappearance_distance) and self.reappearance_distance >= 0.0):
@@ -75,6 +80,10 @@ class RepairConfig:
             )
         if not (0.0 <= self.ambiguity_margin < 1.0):
             raise ConfigurationError(f"anchoring ambiguity_margin must be in [0, 1), got {self.ambiguity_margin}.")
+        if not (0.0 <= self.same_space_overlap <= 1.0):
+            raise ConfigurationError(
+                f"anchoring same_space_overlap must be in [0, 1] (0 turns it off), got {self.same_space_overlap}."
+            )
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -149,17 +158,10 @@ class IdentityRepair:
         """
         if self.config.reappearance_distance <= 0.0:
             return []
-        in_question = {anchor.symbol: anchor for anchor in lost}
-        for newcomer in newcomers:
-            for anchor in self._near(newcomer, index):
-                if anchor.state is AnchorState.MISSING:
-                    in_question.setdefault(anchor.symbol, anchor)
+        near_newcomers = [anchor for newcomer in newcomers for anchor in self._near(newcomer, index)]
         decisions: list[Decision] = []
         taken: set[str] = set()
-        for symbol in sorted(in_question):
-            missing = in_question[symbol]
-            if missing.state is not AnchorState.MISSING or missing.expectation is not None:
-                continue
+        for missing in _in_question(lost, near_newcomers):
             candidates = [
                 anchor for anchor in self._near(missing, index)
                 if anchor.symbol not in taken and anchor.state is AnchorState.CONFIRMED
@@ -192,18 +194,11 @@ class IdentityRepair:
         """
         if self.arrival_frames <= 0:
             return []
-        in_question = {anchor.symbol: anchor for anchor in lost}
-        for newcomer in newcomers:
-            if self._arrived(newcomer):
-                for anchor in index.of_class(newcomer.class_name):
-                    if anchor.state is AnchorState.MISSING:
-                        in_question.setdefault(anchor.symbol, anchor)
+        of_arrivals_class = [anchor for newcomer in newcomers if self._arrived(newcomer)
+                             for anchor in index.of_class(newcomer.class_name)]
         merges: list[Merge] = []
         taken: set[str] = set()
-        for symbol in sorted(in_question):
-            missing = in_question[symbol]
-            if missing.state is not AnchorState.MISSING or missing.expectation is not None:
-                continue
+        for missing in _in_question(lost, of_arrivals_class):
             near = {anchor.symbol for anchor in self._near(missing, index)}
             candidates = [
                 anchor for anchor in index.of_class(missing.class_name)
@@ -331,3 +326,13 @@ class IdentityRepair:
         distance = np.linalg.norm(index.positions_of(slots) - anchor.position, axis=1)
         slack = np.maximum(index.extent_slacks_of(slots), own_slack)
         return [other for other in index.anchors_at(slots[distance - slack <= reach]) if other is not anchor]
+
+
+def _in_question(lost: Iterable[Anchor], brought_in: Iterable[Anchor]) -> list[Anchor]:
+    """The MISSING anchors with nothing expected of them among those that went missing this frame
+    and those a newcomer brings into question, each once, in symbol order."""
+    in_question = {anchor.symbol: anchor for anchor in (*lost, *brought_in)}
+    return [
+        in_question[symbol] for symbol in sorted(in_question)
+        if in_question[symbol].state is AnchorState.MISSING and in_question[symbol].expectation is None
+    ]

@@ -3,7 +3,8 @@
 A merge keeps the older symbol, since that is the one the planner and the knowledge base know:
 the kept anchor takes the merged one's views, sightings and class votes, and, when the object
 was found elsewhere, its place. An undecided case changes no identity: each lost anchor records
-what it cannot be told from, and an AMBIGUOUS event says so.
+what it cannot be told from, and an AMBIGUOUS event says so. A duplicate (:mod:`.same_space`) is
+forgotten, its object keeping the other symbol.
 """
 
 from __future__ import annotations
@@ -15,11 +16,23 @@ from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, Merge
 from merlin2_sailor.anchoring.observation import drop_expectation
+from merlin2_sailor.anchoring.same_space import Duplicate
 
 
-def apply_decision(decision: Decision | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig) -> None:
-    """Carry out a merge, or report what could not be decided."""
+def apply_decision(
+    decision: Decision | Duplicate | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig
+) -> None:
+    """Carry out a merge, forget a duplicate, or report what could not be decided."""
     if decision is None:
+        return
+    if isinstance(decision, Duplicate):
+        duplicate = decision.duplicate
+        index.remove(duplicate.symbol)
+        duplicate.visible = False
+        duplicate.state = AnchorState.FORGOTTEN
+        changes.forgotten.append(duplicate)
+        changes.event(AnchorEventKind.FORGOTTEN, duplicate.symbol,
+                      reason=f"{decision.reason}: a second anchor of its object", overlap=round(decision.overlap, 2))
         return
     if not isinstance(decision, Merge):
         involved = [anchor.symbol for anchor in (*decision.lost, *decision.found)]

@@ -340,6 +340,10 @@ SETTINGS: tuple[Setting, ...] = (
                 "How much better than every rival a candidate for a merge must score to be taken (scores "
                 "closer than this cannot tell two look-alikes apart: nothing is merged, and it is said).",
                 0.0, 0.99),
+        Setting("same_space_overlap", ("core", "repair", "same_space_overlap"),
+                "Share of the smaller 3D box that a missing anchor and an anchor of its class seen in its "
+                "place must have in common to be one object (two objects cannot fill one space): the younger "
+                "is a second anchor left by a slip, and goes (0 turns it off).", 0.0, 1.0),
         Setting("relocation_watched_frames", ("core", "watch", "frames_to_arrive"),
                 "Frames the camera must have watched a place, with no unknown object of a class in it, for an "
                 "object of that class first seen there to count as having arrived (moved): only such an object "

@@ -1,0 +1,93 @@
+"""Two anchors of one class in one space are one object: the second is what a slip left behind.
+
+When percepts slide (the pose estimate drifts while the robot drives, seven books stand 2 cm
+apart), the assignment can hand one object's percepts to its neighbour's anchor for a few frames
+and give the object a second anchor; once the percepts are back in place, one of the two is seen
+there and the other goes MISSING on the very spot. Identity repair's other rules leave such a
+pair alone, since both were seen at one time ("two anchors seen side by side are two objects").
+But two objects cannot fill the same space: when the 3D boxes of a MISSING anchor and of an
+anchor of its class confirmed and seen in this frame share at least ``minimum_overlap`` of the
+smaller box, and their colours do not differ, they are one object. Measured on the scenario
+suite of 3 December 2026: every duplicate anchor left in `crowded_shelf` (both matchers) and
+three of the five in `removed` (rules) were such pairs (overlap 0.6-1.0).
+
+The older symbol stays, as in every merge, since it is the one the planner knows: a MISSING
+anchor older than the one seen takes it over (a :class:`~.identity_repair.Merge`); a younger
+MISSING one is forgotten as a :class:`Duplicate` (its few sightings were the slip's). A pair that
+never stood together (the seen one born after the missing one's last sighting) is not a slip but
+perhaps an object put in another's place, which the reappearance rules judge instead.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.identity_repair import Merge
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Duplicate:
+    """``duplicate`` (MISSING) was a second anchor of ``kept``'s object: it is forgotten."""
+
+    kept: Anchor
+    duplicate: Anchor
+    overlap: float
+    reason: str
+
+
+def shared_volume(first: Anchor, second: Anchor) -> float:
+    """The share of the smaller of the two anchors' axis-aligned boxes that lies in both (0..1)."""
+    low = np.maximum(first.position - first.size / 2.0, second.position - second.size / 2.0)
+    high = np.minimum(first.position + first.size / 2.0, second.position + second.size / 2.0)
+    common = float(np.prod(np.clip(high - low, 0.0, None)))
+    smaller = min(float(np.prod(first.size)), float(np.prod(second.size)))
+    return common / smaller if smaller > 0.0 else 0.0
+
+
+def decide_same_space(
+    seen: Iterable[Anchor], index: AnchorIndex, minimum_overlap: float, colour: ColourEvidenceConfig
+) -> list[Merge | Duplicate]:
+    """Decisions for MISSING anchors that share their space with an anchor ``seen`` this frame
+    (0 ``minimum_overlap`` turns the rule off)."""
+    if minimum_overlap <= 0.0:
+        return []
+    current = {anchor.symbol: anchor for anchor in seen
+               if anchor.state is AnchorState.CONFIRMED and anchor.visible and anchor.expectation is None}
+    if not current:
+        return []
+    anchors = list(current.values())
+    radius = max(float(np.linalg.norm(anchor.size)) for anchor in anchors) + index.largest_extent_slack()
+    decisions: list[Merge | Duplicate] = []
+    settled: set[str] = set()
+    for anchor, slots in zip(anchors, index.within(np.array([a.position for a in anchors]), radius), strict=True):
+        for other in index.anchors_at(slots):
+            if anchor.symbol in settled or other.symbol in settled or not _may_be_one(anchor, other, colour):
+                continue
+            overlap = shared_volume(anchor, other)
+            if overlap < minimum_overlap:
+                continue
+            settled.update((anchor.symbol, other.symbol))
+            if other.first_seen < anchor.first_seen:
+                decisions.append(Merge(other, anchor, overlap, "a second anchor in the same space", moved=True))
+            else:
+                decisions.append(Duplicate(anchor, other, overlap, f"in the same space as {anchor.symbol}"))
+    return decisions
+
+
+def _may_be_one(seen: Anchor, missing: Anchor, colour: ColourEvidenceConfig) -> bool:
+    """A MISSING anchor of the seen one's class, with nothing expected of it, that stood together
+    with it at some time, and not of another colour."""
+    return (
+        missing is not seen
+        and missing.state is AnchorState.MISSING
+        and missing.expectation is None
+        and missing.class_name == seen.class_name
+        and seen.first_seen < missing.last_seen
+        and not colours_differ(seen.colour, missing.colour, colour)
+    )

@@ -1,0 +1,126 @@
+"""A missing anchor in the very space of an anchor of its class seen there is a second anchor of that object.
+
+The case comes from the scenario suite: seven books 2 cm apart, percepts sliding while the robot
+drove, left one book with a second anchor, MISSING on the spot where the first is seen (both
+matchers), and the long search of `removed` left birds, cats and books the same way. Tested
+below on a detector that reports one mug twice for a while, then on the rules' limits: two books
+side by side, a mug of another colour in a lost mug's place, a pair that never stood together, a
+sought anchor, and which symbol stays.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
+from merlin2_sailor.anchoring.identity_repair import Merge, RepairConfig
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
+from merlin2_sailor.anchoring.same_space import Duplicate, decide_same_space, shared_volume
+from merlin2_sailor.errors import ConfigurationError
+
+from .anchoring_scenes import PerceptMaker, SceneObject, camera_view, mug_colour
+
+FRAME = 1.0 / 15.0
+RED, GREEN = 17, 6
+BOOK_SIZE = np.array((0.16, 0.04, 0.24))
+COLOUR = ColourEvidenceConfig()
+
+
+def book(symbol: str, x: float, state: AnchorState, first_seen: float, last_seen: float, hue: int | None = None):
+    anchor = Anchor(symbol, "book", np.array((x, 2.0, 1.0)), BOOK_SIZE.copy(), first_seen, last_seen, state=state,
+                    perceived_position=np.array((x, 2.0, 1.0)))
+    anchor.visible = state is AnchorState.CONFIRMED
+    if hue is not None:
+        anchor.colour = ColourModel.of(mug_colour(hue))
+        for _ in range(4):
+            anchor.colour.add(mug_colour(hue))
+    return anchor
+
+
+def decide(*anchors: Anchor, overlap: float = 0.5):
+    index = AnchorIndex()
+    for anchor in anchors:
+        index.add(anchor)
+    seen = [anchor for anchor in anchors if anchor.visible]
+    return decide_same_space(seen, index, overlap, COLOUR)
+
+
+def test_a_detector_reporting_one_mug_twice_leaves_one_anchor_once_the_double_is_gone():
+    maker = PerceptMaker(seed=3)
+    lifecycle = LifecycleConfig(confirm_after=2, missed_frames_to_missing=1, forget_after=600.0)
+    anchoring = Anchoring(AnchoringConfig(lifecycle=lifecycle))
+    mug = SceneObject("mug", "cup", (2.5, 0.0, 0.8))
+    double = SceneObject("mug", "cup", (2.5, 0.04, 0.8))
+    stamp, events = 0.0, []
+    for frame in range(20):
+        items = [mug, double] if 3 <= frame < 8 else [mug]
+        result = anchoring.process([maker.percept(item, stamp) for item in items], camera_view(), stamp)
+        events.extend(result.events)
+        stamp += FRAME
+    assert [(a.symbol, a.state) for a in anchoring.anchors] == [("cup_1", AnchorState.CONFIRMED)]
+    gone = [e for e in events if e.kind is AnchorEventKind.FORGOTTEN]
+    assert len(gone) == 1 and gone[0].symbol == "cup_2"
+    assert gone[0].details["reason"].startswith("in the same space as cup_1")
+
+
+def test_the_younger_missing_anchor_goes_and_an_older_missing_one_takes_the_seen_one_over():
+    older_missing = book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0)
+    seen = book("book_9", 2.03, AnchorState.CONFIRMED, 40.0, 60.0)
+    [merge] = decide(older_missing, seen)
+    assert isinstance(merge, Merge) and (merge.kept, merge.merged) == (older_missing, seen)
+
+    younger_missing = book("book_9", 2.03, AnchorState.MISSING, 40.0, 50.0)
+    seen = book("book_1", 2.00, AnchorState.CONFIRMED, 0.0, 60.0)
+    [duplicate] = decide(younger_missing, seen)
+    assert isinstance(duplicate, Duplicate) and (duplicate.kept, duplicate.duplicate) == (seen, younger_missing)
+    assert duplicate.overlap == pytest.approx(shared_volume(seen, younger_missing))
+
+
+def test_two_books_side_by_side_are_two_books():
+    """18 cm between centres, 16 cm wide: the boxes do not meet."""
+    assert decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0),
+                  book("book_2", 2.18, AnchorState.CONFIRMED, 0.0, 60.0)) == []
+
+
+def test_an_anchor_of_another_colour_in_a_lost_ones_place_is_another_object():
+    """The swap: the green book put where the red one stood."""
+    assert decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0, hue=RED),
+                  book("book_2", 2.01, AnchorState.CONFIRMED, 40.0, 60.0, hue=GREEN)) == []
+    assert len(decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0, hue=RED),
+                      book("book_2", 2.01, AnchorState.CONFIRMED, 40.0, 60.0, hue=RED))) == 1
+
+
+def test_a_pair_that_never_stood_together_is_left_to_the_reappearance_rules():
+    """Born after the missing one's last sighting: perhaps another book put in its place."""
+    assert decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 30.0),
+                  book("book_2", 2.01, AnchorState.CONFIRMED, 40.0, 60.0)) == []
+
+
+def test_a_sought_anchor_and_an_anchor_of_another_class_are_left_alone():
+    sought = book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0)
+    sought.expectation = Expectation.at(sought.position, 55.0, "living_room", "find", radius=1.0)
+    assert decide(sought, book("book_2", 2.01, AnchorState.CONFIRMED, 0.0, 60.0)) == []
+    vase = book("vase_1", 2.01, AnchorState.CONFIRMED, 0.0, 60.0)
+    vase.class_name = "vase"
+    assert decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0), vase) == []
+
+
+@pytest.mark.parametrize(("offset", "shared"), [(0.0, 1.0), (0.04, 0.75), (0.08, 0.5), (0.16, 0.0), (0.3, 0.0)])
+def test_shared_volume_is_the_share_of_the_smaller_box(offset, shared):
+    first = book("book_1", 2.0, AnchorState.MISSING, 0.0, 1.0)
+    second = book("book_2", 2.0 + offset, AnchorState.CONFIRMED, 0.0, 1.0)
+    assert shared_volume(first, second) == pytest.approx(shared)
+    second.size = BOOK_SIZE / 2.0
+    second.position = first.position.copy()
+    assert shared_volume(first, second) == pytest.approx(1.0)
+
+
+def test_the_rule_can_be_turned_off_and_is_checked():
+    assert decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 50.0),
+                  book("book_2", 2.01, AnchorState.CONFIRMED, 0.0, 60.0), overlap=0.0) == []
+    with pytest.raises(ConfigurationError, match="same_space_overlap"):
+        RepairConfig(same_space_overlap=1.5)
