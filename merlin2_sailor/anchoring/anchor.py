@@ -95,6 +95,12 @@ class Anchor:
     watched_before: int = 0
     """Frames in which the camera had watched its place, with no unknown object of its class there,
     before it was first seen (:mod:`.watched_places`): many means it arrived there since, moved."""
+    left_place: np.ndarray | None = None
+    """Where it stood before its latest jump (one sighting moved it far), while a newcomer seen
+    there may still show that the jump went to another object (:mod:`.place_return`); None when
+    it has not jumped lately. Not persisted: it matters for a few seconds."""
+    left_at: float = 0.0
+    """When it left ``left_place``."""
 
     @property
     def confidence(self) -> float:

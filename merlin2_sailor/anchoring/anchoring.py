@@ -41,6 +41,7 @@ from merlin2_sailor.anchoring.merge import apply_decision
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
+from merlin2_sailor.anchoring.place_return import Return, decide_returns, note_jump
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.same_space import Duplicate, decide_same_space
 from merlin2_sailor.anchoring.snapshot import anchors_of_snapshot, snapshot_of
@@ -201,8 +202,10 @@ class Anchoring:
         for row, column in assignment.matches:
             anchor = table.anchors[column]
             unknown[row] = anchor.state is AnchorState.TENTATIVE
+            before = anchor.position.copy()
             reacquire(anchor, percepts[row], changes, config.fusion, config.lifecycle, config.expectation_tolerance,
                       continued=bool(table.continuations[row, column]), partial=partial[row])
+            note_jump(anchor, before, stamp, config.repair.place_jump, config.repair.place_review)
             self._index.refresh(anchor)
             symbols[row] = anchor.symbol
 
@@ -348,7 +351,11 @@ class Anchoring:
 
     def _repair_identities(self, changes: FrameChanges) -> dict[str, str]:
         """Apply identity repair after a frame; return {merged symbol: kept symbol}."""
-        decisions: list[Decision | Duplicate | None] = list(
+        repair = self.config.repair
+        # A jump undone comes first: the anchors it swaps back are then judged in their right places.
+        decisions: list[Decision | Duplicate | Return | None] = list(decide_returns(
+            changes.acquired, self._index, changes.stamp, repair.place_jump, repair.place_review, self.config.colour))
+        decisions.extend(
             self._repair.decide_reappearances(changes.missing, changes.confirmed_newcomers, self._index))
         # An arrival is judged when it is confirmed and again when its colour becomes known (a
         # relocation needs both colours), whichever comes last.
@@ -366,13 +373,14 @@ class Anchoring:
                     decisions.append(self._repair.decide_search(sought, sought.expectation, self._index))
         renamed: dict[str, str] = {}
         for decision in decisions:
-            involved = (decision.kept, decision.merged) if isinstance(decision, Merge) else (
-                (decision.kept, decision.duplicate) if isinstance(decision, Duplicate) else ())
-            if any(anchor.symbol not in self._index for anchor in involved):
+            if any(anchor.symbol not in self._index for anchor in _involved(decision)):
                 continue  # an earlier decision of this frame already merged or forgot one of them
             apply_decision(decision, self._index, changes, self.config.fusion)
             if isinstance(decision, Merge):
                 renamed[decision.merged.symbol] = decision.kept.symbol
+            elif isinstance(decision, Return):  # this frame's percepts swap symbols too
+                renamed[decision.anchor.symbol] = decision.newcomer.symbol
+                renamed[decision.newcomer.symbol] = decision.anchor.symbol
         return renamed
 
     def _move_to_expected(self, anchor: Anchor, position: np.ndarray) -> None:
@@ -390,3 +398,14 @@ class Anchoring:
         if anchor is None:
             raise InvalidInputError(f"No anchor is named {symbol!r}; it was never acquired or has been forgotten.")
         return anchor
+
+
+def _involved(decision: Decision | Duplicate | Return | None) -> tuple[Anchor, ...]:
+    """The anchors a decision changes (all must still be anchored for it to be carried out)."""
+    if isinstance(decision, Merge):
+        return decision.kept, decision.merged
+    if isinstance(decision, Duplicate):
+        return decision.kept, decision.duplicate
+    if isinstance(decision, Return):
+        return decision.anchor, decision.newcomer
+    return ()

@@ -4,7 +4,8 @@ A merge keeps the older symbol, since that is the one the planner and the knowle
 the kept anchor takes the merged one's views, sightings and class votes, and, when the object
 was found elsewhere, its place. An undecided case changes no identity: each lost anchor records
 what it cannot be told from, and an AMBIGUOUS event says so. A duplicate (:mod:`.same_space`) is
-forgotten, its object keeping the other symbol.
+forgotten, its object keeping the other symbol. A jump undone (:mod:`.place_return`) trades the
+two anchors' places, so each symbol is back on its own object.
 """
 
 from __future__ import annotations
@@ -16,14 +17,27 @@ from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, Merge
 from merlin2_sailor.anchoring.observation import drop_expectation
+from merlin2_sailor.anchoring.percept_checks import position_text
+from merlin2_sailor.anchoring.place_return import Return, trade_places
 from merlin2_sailor.anchoring.same_space import Duplicate
 
 
 def apply_decision(
-    decision: Decision | Duplicate | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig
+    decision: Decision | Duplicate | Return | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig
 ) -> None:
-    """Carry out a merge, forget a duplicate, or report what could not be decided."""
+    """Carry out a merge, forget a duplicate, undo a jump, or report what could not be decided."""
     if decision is None:
+        return
+    if isinstance(decision, Return):
+        anchor, newcomer = decision.anchor, decision.newcomer
+        trade_places(decision)
+        index.refresh(anchor)
+        index.refresh(newcomer)
+        if anchor not in changes.reacquired:
+            changes.reacquired.append(anchor)
+        changes.event(AnchorEventKind.REACQUIRED, anchor.symbol, was_missing=False,
+                      reason=f"seen again on the place it had left; its {decision.jump:.2f} m jump went to "
+                             f"another object, now {newcomer.symbol}", at=position_text(anchor.position))
         return
     if isinstance(decision, Duplicate):
         duplicate = decision.duplicate

@@ -344,6 +344,13 @@ SETTINGS: tuple[Setting, ...] = (
                 "Share of the smaller 3D box that a missing anchor and an anchor of its class seen in its "
                 "place must have in common to be one object (two objects cannot fill one space): the younger "
                 "is a second anchor left by a slip, and goes (0 turns it off).", 0.0, 1.0),
+        Setting("place_jump", ("core", "repair", "place_jump"),
+                "How far (m) from a place an anchor must have gone, by a sudden move (half of it in one "
+                "sighting), for a newcomer of its class seen soon after on that place to show that the move "
+                "went to a look-alike: the anchor goes back to its object and the newcomer takes the "
+                "look-alike (0 turns it off).", 0.0, 10.0),
+        Setting("place_review", ("core", "repair", "place_review"),
+                "For how long (s) after such a jump a newcomer on the place left is looked for.", 0.0, 60.0),
         Setting("relocation_watched_frames", ("core", "watch", "frames_to_arrive"),
                 "Frames the camera must have watched a place, with no unknown object of a class in it, for an "
                 "object of that class first seen there to count as having arrived (moved): only such an object "

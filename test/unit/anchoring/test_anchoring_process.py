@@ -240,6 +240,30 @@ def test_a_tracker_id_that_lands_on_another_object_is_a_swap_not_evidence(make_a
     assert result.percept_symbols == (symbols[mug_a.identity], symbols[mug_b.identity])
 
 
+@pytest.mark.parametrize("newcomer_offset", [(0.0, 0.28, 0.0), (0.2, -0.15, 0.0), (-0.3, 0.0, 0.05)])
+@pytest.mark.parametrize("known_mug_id", ["9", ""])
+def test_a_tracker_id_handed_to_a_newcomer_leaves_the_known_object_its_anchor(
+    make_anchoring, maker, kitchen, newcomer_offset, known_mug_id
+):
+    """A look-alike put down beside a known mug while the camera turns away: the 2D tracker hands
+    the known mug's id to the newcomer's box and starts a new id (or none) for the known mug. The
+    known mug, seen in this frame right where its anchor is, keeps its symbol; the id is not
+    evidence against a percept standing where the anchor stands."""
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    for frame in range(3):
+        anchoring.process([maker.percept(cup, frame * FRAME, tracker_id="7")], None, frame * FRAME)
+    newcomer_at = np.asarray(cup.position) + newcomer_offset
+    stamp = 3 * FRAME
+    frame_percepts = [
+        maker.percept(cup, stamp, tracker_id="7", position=newcomer_at),
+        maker.percept(cup, stamp, tracker_id=known_mug_id),
+    ]
+    result = anchoring.process(frame_percepts, None, stamp)
+    assert result.percept_symbols[1] == "cup_1"
+    assert result.percept_symbols[0] not in ("cup_1", None)
+
+
 def test_tracker_id_never_overrides_a_class_mismatch(maker, kitchen):
     config = AnchoringConfig(
         lifecycle=LifecycleConfig(confirm_after=1), table=MatchingTableConfig(gate_class_mismatch=False)
