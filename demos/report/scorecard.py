@@ -177,8 +177,13 @@ def score(
     }
     matched_symbols = set(association.values())
     unmatched = [anchor for anchor in claiming if anchor.symbol not in matched_symbols]
+    # The last anchor of an object taken out of the world, MISSING, is the truth ("it is gone"):
+    # neither a duplicate nor a spurious anchor. Confirmed, it would still claim the object is there.
+    gone = {symbol for object_id, symbol in history.last_symbol.items() if object_id not in by_id}
     duplicates, spurious = [], []
     for anchor in unmatched:
+        if anchor.state == "missing" and anchor.symbol in gone:
+            continue
         near_same_class = any(
             obj.class_name == anchor.class_name
             and np.linalg.norm(np.subtract(obj.position, anchor.position)) <= 2 * max_distance

@@ -57,6 +57,24 @@ def test_the_scorecard_counts_misses_duplicates_errors_and_facts():
     assert "| anchored (exactly one anchor each) | 3 / 4 |" in table and "book_1" in table
 
 
+def test_the_missing_anchor_of_a_removed_object_is_no_duplicate():
+    """The red mug was taken out of the house: its anchor, MISSING where it stood beside another
+    mug, is what should remain; confirmed there it would still claim a mug that is gone."""
+    history = IdentityHistory()
+    history.record({"mug_a": "cup_1", "mug_b": "cup_2"})
+    without_mug_a = TRUTH[1:]
+    near_mug_b = (4.3, 0.0, 0.8)
+    missing = score(without_mug_a, [AnchorRecord("cup_2", "cup", (4.0, 0.0, 0.8)),
+                                    AnchorRecord("cup_1", "cup", near_mug_b, state="missing")], history=history)
+    assert missing.duplicates == () and missing.spurious == ()
+    confirmed = score(without_mug_a, [AnchorRecord("cup_2", "cup", (4.0, 0.0, 0.8)),
+                                      AnchorRecord("cup_1", "cup", near_mug_b)], history=history)
+    assert confirmed.duplicates == ("cup_1",)
+    never_an_object = score(TRUTH, [AnchorRecord("cup_1", "cup", (1.0, 0.0, 0.8)),
+                                    AnchorRecord("cup_9", "cup", (1.3, 0.0, 0.8), state="missing")])
+    assert never_an_object.duplicates == ("cup_9",)
+
+
 def test_identity_switches_are_symbol_changes_of_one_object():
     history = IdentityHistory()
     history.record({"mug_a": "cup_1", "mug_b": "cup_2"})
