@@ -127,7 +127,7 @@ class Anchor:
             class_votes=vote_class({}, percept.class_name, percept.score),
             position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
             whole_views=0 if partial else 1,
-            gallery=None if embedding is None else add_to_gallery(None, embedding, config.gallery_size),
+            gallery=None if embedding is None or partial else add_to_gallery(None, embedding, config.gallery_size),
             colour=None if partial else with_view(None, percept.colour),
             colour_seen=None if partial or percept.colour is None else percept.stamp,
             visible=True,
@@ -142,7 +142,7 @@ class Anchor:
         A ``partial`` view (cut by the image's edge or an occluder, see :mod:`.partial_view`) is
         centred on the part in view: once the anchor has had a whole view, a partial one keeps it
         alive but moves and resizes it no more; before that, it is the best there is, but weighs
-        ``partial_view_variance_factor`` times less.
+        ``partial_view_variance_factor`` times less. Its crop never joins the appearance gallery.
         """
         self.times_seen += 1
         if not partial or self.whole_views == 0:
@@ -159,7 +159,7 @@ class Anchor:
                 self.colour_disputed = False
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
-        if embedding is not None:
+        if embedding is not None and not partial:  # a part's look is not the object's (matching_table)
             self.gallery = add_to_gallery(self.gallery, embedding, config.gallery_size)
         if percept.tracker_id:
             self.last_tracker_id = percept.tracker_id

@@ -28,6 +28,7 @@ from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
 from merlin2_sailor.anchoring.gallery import from_bfloat16_bits
 from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.partial_view import comparable_views
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,7 +46,10 @@ def identity_scores(
     candidate: a (len(candidates),) array in [0, 1]."""
     if not candidates:
         return np.zeros(0)
-    percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance)
+    # A candidate that knows only a part of a large lost object (a view end-on, through a door)
+    # is compared without its look, as a partial percept is (matching_table.comparable_views).
+    comparable = comparable_views(np.array([anchor.size for anchor in candidates]), None, [lost])[:, 0]
+    percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
     anchors = AnchorColumns.from_anchors([lost])
     if disc is None:
         anchors = dataclasses.replace(anchors, perceived_positions=None, search_radii=None)
@@ -66,13 +70,17 @@ def identity_scores(
     return np.bincount(owners, weights=per_view, minlength=len(candidates)) / views
 
 
-def _candidates_as_percepts(candidates: Sequence[Anchor], with_views: bool) -> tuple[PerceptColumns, np.ndarray]:
+def _candidates_as_percepts(
+    candidates: Sequence[Anchor], with_views: np.ndarray
+) -> tuple[PerceptColumns, np.ndarray]:
     """One pseudo-percept per gallery view of each candidate (one, without embedding, if it has
-    none); returns the columns and, per row, the candidate it stands for."""
+    none or ``with_views`` is False for it); returns the columns and, per row, the candidate it
+    stands for."""
     owners: list[int] = []
     views: list[np.ndarray | None] = []
     for number, anchor in enumerate(candidates):
-        gallery = anchor.gallery if with_views and anchor.gallery is not None and len(anchor.gallery) else None
+        usable = with_views[number] and anchor.gallery is not None and len(anchor.gallery)
+        gallery = anchor.gallery if usable else None
         entries = [None] if gallery is None else list(from_bfloat16_bits(gallery))
         owners.extend([number] * len(entries))
         views.extend(entries)

@@ -210,7 +210,7 @@ class Anchoring:
             symbols[row] = anchor.symbol
 
         unmatched = [int(row) for row in assignment.unmatched_percepts]
-        percepts = self._embed_for_gallery(percepts, unmatched)
+        percepts = self._embed_for_gallery(percepts, [row for row in unmatched if not partial[row]])
         # New anchors of one class in one frame take their symbols in the order of their places, not
         # of the detector's list (which a detector may shuffle): the same frames give the same
         # symbols, live or replayed from a bag, whichever order the detections came in.

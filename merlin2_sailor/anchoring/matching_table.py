@@ -21,7 +21,9 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
    floor; a class mismatch never is;
 4. **one vectorised feature computation and one matcher call** for all remaining pairs;
-5. **colour evidence**: a whole view whose colour rules out an anchor unseen for a while (a
+5. **appearance only from comparable views**: a partial view's crop is not compared with an
+   anchor's views (:func:`.partial_view.comparable_views`), nor embedded for it;
+6. **colour evidence**: a whole view whose colour rules out an anchor unseen for a while (a
    look-alike of another colour put in its place) is gated from it, whatever the matcher scored
    (:func:`~.colour_evidence.view_differs`).
 """
@@ -42,6 +44,7 @@ from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracke
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, view_differs
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.partial_view import comparable_views
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 
@@ -194,7 +197,8 @@ class MatchingTableBuilder:
         continuations &= ~gated
 
         to_score = ~gated & ~shortcut[:, np.newaxis]
-        percepts, embedded = self._embed_needed(percepts, np.flatnonzero(to_score.any(axis=1)))
+        comparable = comparable_views(columns.sizes, whole, anchors)
+        percepts, embedded = self._embed_needed(percepts, np.flatnonzero((to_score & comparable).any(axis=1)))
         if embedded:
             columns = PerceptColumns.from_percepts(percepts)
 
@@ -204,6 +208,8 @@ class MatchingTableBuilder:
             features = pair_features(
                 columns, anchor_columns, rows, score_columns, self.matcher.feature_config, self.matcher.uses_appearance
             )
+            features = dataclasses.replace(
+                features, appearance_known=features.appearance_known & comparable[rows, score_columns])
             scores[rows, score_columns] = self.matcher.score_pairs(features)
         if anchor_columns.search_radii is not None:
             searched = (anchor_columns.search_radii > 0.0)[np.newaxis, :] & to_score

@@ -10,13 +10,20 @@ import pytest
 
 from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, AnchorState
 from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_comparison import identity_scores
 from merlin2_sailor.anchoring.features import extent_slack
-from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, smaller_than_known
+from merlin2_sailor.anchoring.partial_view import (
+    PartialViewConfig,
+    comparable_views,
+    partial_views,
+    smaller_than_known,
+)
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError
 
-from .anchoring_scenes import PerceptMaker, SceneObject, camera_view, flat_depth
+from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, camera_view, flat_depth
 
 #: A 1.6 m long bicycle standing along +y, 3 m ahead of the camera at the origin (looking along +x).
 BICYCLE = SceneObject("bicycle", "bicycle", (3.0, 0.0, 0.5), (0.35, 1.6, 1.0))
@@ -125,3 +132,72 @@ def test_whole_views_survive_a_snapshot(maker) -> None:
     del legacy["whole_views"]  # a snapshot saved before the field existed
     assert anchor_from_dict(legacy).whole_views == 0
 
+
+
+def looks(maker: PerceptMaker, identity: str) -> np.ndarray:
+    return maker.appearance(identity).copy()
+
+
+def test_a_part_is_not_compared_by_its_look_with_a_learned_matcher(maker) -> None:
+    """With appearance in the matching function: the bicycle's whole views fill its gallery; a
+    view of its near end (a part, which looks like nothing of the whole) is scored without its
+    look, as the rules score it, and neither makes a second bicycle nor joins the gallery; a whole
+    view that looks like another object in the same place is still told apart by its look."""
+    anchoring = Anchoring(AnchoringConfig(), matcher=AppearanceRules())
+    camera = camera_view()
+    whole = looks(maker, "bicycle")
+    for frame in range(3):
+        percept = dataclasses.replace(view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX), embedding=whole)
+        anchoring.process([percept], camera, frame * 0.1)
+    [bicycle] = anchoring.anchors
+    gallery_before = bicycle.gallery.copy()
+    part_look = looks(maker, "a bicycle's near end")
+    for frame, (box, centre, size) in enumerate([
+        (MIDDLE_BOX, (3.0, -0.6, 0.5), (0.35, 0.4, 1.0)),  # end-on: much less than the known extent
+        (EDGE_BOX, (3.0, 0.4, 0.5), (0.35, 0.8, 1.0)),  # cut by the image's edge
+    ], start=3):
+        part = dataclasses.replace(view_of(maker, BICYCLE, frame * 0.1, box, centre=centre, size=size),
+                                   embedding=part_look)
+        result = anchoring.process([part], camera, frame * 0.1)
+        assert result.percept_symbols == (bicycle.symbol,), f"{box}: a part made a second bicycle"
+    np.testing.assert_array_equal(bicycle.gallery, gallery_before)
+    other_look = dataclasses.replace(view_of(maker, BICYCLE, 0.6, MIDDLE_BOX), embedding=looks(maker, "a trolley"))
+    assert anchoring.process([other_look], camera, 0.6).acquired, "a whole view's look must still count"
+
+
+def test_comparable_views_are_whole_views_of_no_less_than_the_known_extent(maker) -> None:
+    fusion = AnchoringConfig().fusion
+    bicycle = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), None, fusion)
+    mug = SceneObject("mug", "cup", (3.0, 0.5, 0.8))
+    mug_anchor = Anchor.from_percept("cup_1", view_of(maker, mug, 0.0, MIDDLE_BOX), None, fusion)
+    percepts = [
+        view_of(maker, BICYCLE, 1.0, MIDDLE_BOX),  # whole
+        view_of(maker, BICYCLE, 1.0, MIDDLE_BOX, size=(0.35, 0.3, 1.0)),  # end-on
+        view_of(maker, BICYCLE, 1.0, EDGE_BOX),  # cut by the edge
+        view_of(maker, mug, 1.0, MIDDLE_BOX, size=(0.03, 0.03, 0.1)),  # small: noise for a mug, no view of a bicycle
+    ]
+    sizes = np.array([percept.size for percept in percepts])
+    comparable = comparable_views(sizes, [True, True, False, True], [bicycle, mug_anchor])
+    assert comparable.tolist() == [[True, True], [False, True], [False, False], [False, True]]
+    # no camera: the edge is not known, the extent still tells
+    assert comparable_views(sizes, None, [bicycle, mug_anchor]).tolist() == [
+        [True, True], [False, True], [True, True], [False, True]]
+    never_whole = Anchor.from_percept("bicycle_2", view_of(maker, BICYCLE, 0.0, EDGE_BOX), None, fusion, partial=True)
+    assert comparable_views(sizes[1:2], [True], [never_whole]).tolist() == [[True]]
+
+
+def test_an_anchor_knowing_only_part_of_a_lost_large_object_is_compared_without_its_look(maker) -> None:
+    """Identity repair compares anchors as matching compares percepts: a newer anchor that saw the
+    bicycle only end-on is judged by class, place and time against the lost one, while a newer
+    anchor of the whole extent that looks like something else is still told apart by its look."""
+    fusion = AnchoringConfig().fusion
+    lost = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), looks(maker, "bicycle"), fusion)
+    end_on = Anchor.from_percept("bicycle_2", view_of(maker, BICYCLE, 5.0, MIDDLE_BOX, size=(0.35, 0.4, 1.0)),
+                                 looks(maker, "a bicycle's near end"), fusion)
+    by_rules = identity_scores(RuleMatcher(), [end_on], lost)
+    assert by_rules[0] > 0.5
+    np.testing.assert_allclose(identity_scores(AppearanceRules(), [end_on], lost), by_rules)
+    other_look = Anchor.from_percept("bicycle_3", view_of(maker, BICYCLE, 5.0, MIDDLE_BOX), looks(maker, "a trolley"),
+                                     fusion)
+    [told_apart] = identity_scores(AppearanceRules(), [other_look], lost)
+    assert told_apart < 0.5 * identity_scores(RuleMatcher(), [other_look], lost)[0]
