@@ -296,6 +296,13 @@ class MissionDemoNode(Node):
         self._symbols_before = associate(self._initial_truth, confirmed)
         unnamed = [obj for obj in self._initial_truth if obj.id not in self._symbols_before]
         self._symbols_before.update(associate(unnamed, missing))
+        if self._target not in self._symbols_before:
+            # Moved in view before it could be named (a move the camera watches may begin while the
+            # robot still looks around): its anchor followed it, so it is named where it stands now.
+            # Only then: an object moved unseen is named where it was, where its anchor still is.
+            taken = set(self._symbols_before.values())
+            now = [obj for obj in self._truth() if obj.id == self._target]
+            self._symbols_before.update(associate(now, [a for a in confirmed if a.symbol not in taken]))
         symbol = self._symbols_before.get(self._target)
         self._say(f"the {self._target.replace('_', ' ')} is anchored as {symbol}" if symbol
                   else f"the {self._target.replace('_', ' ')} was not anchored while exploring")
