@@ -28,7 +28,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex, IndexConfig
 from merlin2_sailor.anchoring.assignment import assign
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colour_evidence_grew
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
@@ -355,16 +355,16 @@ class Anchoring:
         # A jump undone comes first: the anchors it swaps back are then judged in their right places.
         decisions: list[Decision | Duplicate | Return | None] = list(decide_returns(
             changes.acquired, self._index, changes.stamp, repair.place_jump, repair.place_review, self.config.colour))
-        decisions.extend(
-            self._repair.decide_reappearances(changes.missing, changes.confirmed_newcomers, self._index))
-        # An arrival is judged when it is confirmed and again when its colour becomes known (a
-        # relocation needs both colours), whichever comes last.
-        colour_known = [
-            anchor for anchor in changes.reacquired
-            if anchor.colour is not None and anchor.colour.views == self.config.colour.minimum_views
-        ]
-        decisions.extend(self._repair.decide_relocations(
-            changes.missing, [*changes.confirmed_newcomers, *colour_known], self._index))
+        # A newcomer is judged when it is confirmed, and again each time its colour evidence grows
+        # (known, then twice, four times... as many views): a newcomer's first views, from afar or
+        # from another side, may differ in colour from a lost anchor that its later views agree
+        # with (a relocation also needs both colours known), and a decision should rest on all of
+        # them. Doubling keeps the re-judging to a few times per anchor.
+        colour_grew = [anchor for anchor in changes.reacquired
+                       if colour_evidence_grew(anchor.colour, self.config.colour.minimum_views)]
+        judged = [*changes.confirmed_newcomers, *colour_grew]
+        decisions.extend(self._repair.decide_reappearances(changes.missing, judged, self._index))
+        decisions.extend(self._repair.decide_relocations(changes.missing, judged, self._index))
         decisions.extend(decide_same_space(changes.reacquired, self._index, self.config.repair.same_space_overlap,
                                            self.config.colour))
         if changes.confirmed_newcomers:  # something new may be what a running search looks for

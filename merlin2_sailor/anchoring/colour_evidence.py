@@ -176,6 +176,15 @@ def colours_agree(first: ColourModel | None, second: ColourModel | None, config:
     return not colours_differ(first, second, config)
 
 
+def colour_evidence_grew(model: ColourModel | None, minimum_views: int) -> bool:
+    """Whether the latest view made the colour known (``minimum_views`` views) or doubled its views
+    since (2, 4, 8... times as many): when an identity decided on colour is worth judging again."""
+    if model is None or minimum_views <= 0 or model.views < minimum_views or model.views % minimum_views:
+        return False
+    times = model.views // minimum_views
+    return times & (times - 1) == 0
+
+
 def view_differs(model: ColourModel | None, histogram: np.ndarray | None, config: ColourEvidenceConfig) -> bool:
     """Whether one whole view's colour shows it is not the anchor's object."""
     return histogram is not None and colours_differ(model, ColourModel.of(histogram), config)

@@ -15,12 +15,13 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, LifecycleConfig
+from merlin2_sailor.anchoring.colour_evidence import colour_evidence_grew, with_view
 from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher, RuleMatcherConfig
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError
 
-from .anchoring_scenes import SceneObject, camera_view
+from .anchoring_scenes import PerceptMaker, SceneObject, camera_view, mug_colour
 
 FRAME = 1.0 / 15.0
 BOOK = SceneObject("desk_book", "book", (3.0, 0.2, 0.9), (0.05, 0.2, 0.26))
@@ -96,6 +97,59 @@ def test_a_false_detection_pulling_a_confirmed_anchor_away_is_undone_in_the_same
         stamp = 20.0 + frame * FRAME
         assert see(anchoring, [maker.percept(BOOK, stamp)], stamp).percept_symbols == ("book_1",)
     assert books(anchoring) == [("book_1", AnchorState.CONFIRMED)]  # the false box's anchor was never confirmed
+
+
+def desk_book(share: float, hue: int = 12) -> SceneObject:
+    return SceneObject("desk_book", "book", BOOK.position, BOOK.size, colour=mug_colour(hue, share=share))
+
+
+def book_seen_again_in_colours(shares: list[float], hue: int = 12) -> tuple[Anchoring, list]:
+    """A desk book seen whole 6 times (its cover's hue on 0.3 of its pixels); 20 s later, views of
+    what stands in its place with the given shares of that hue (far views show less of it, near
+    ones more); returns the anchoring and every event after the absence."""
+    lifecycle = LifecycleConfig(confirm_after=2, missed_frames_to_missing=1, forget_after=600.0)
+    anchoring, maker, stamp, events = Anchoring(AnchoringConfig(lifecycle=lifecycle)), PerceptMaker(seed=1), 0.0, []
+    for _ in range(6):
+        anchoring.process([maker.percept(desk_book(0.3), stamp)], camera_view(), stamp)
+        stamp += FRAME
+    stamp += 20.0
+    for share in shares:
+        events.extend(anchoring.process([maker.percept(desk_book(share, hue), stamp)], camera_view(), stamp).events)
+        stamp += FRAME
+    return anchoring, events
+
+
+@pytest.mark.parametrize("shares", [
+    [0.12, 0.12, 0.48, 0.12, 0.48, 0.12, 0.48, 0.12, 0.48],  # first from afar, then near and far in turn
+    [0.48, 0.48, 0.12, 0.48, 0.12, 0.48, 0.12, 0.48, 0.12],  # first near, then in turn
+    [0.15, 0.15, 0.15, 0.45, 0.45, 0.45, 0.15, 0.45, 0.15, 0.45, 0.15, 0.45],  # known only at the second judging
+])
+def test_a_newcomer_is_judged_again_as_its_colour_evidence_grows(shares):
+    """From the scenario suite (`removed`, both matchers, seed 2): the desk book, seen again from
+    afar, differed in colour from its lost anchor's few views, so it was anchored anew and the
+    reappearance was refused; its later views agreed with the lost anchor, but nothing judged it
+    again, and the book kept two anchors. Every view here differs from the lost anchor's narrow
+    colour (each is gated from it), while the views together agree with it: once the newcomer's
+    colour is known, or has doubled its views, the two are one book."""
+    anchoring, events = book_seen_again_in_colours(shares)
+    assert books(anchoring) == [("book_1", AnchorState.CONFIRMED)]
+    assert any(e.kind is AnchorEventKind.FORGOTTEN and e.symbol == "book_2" for e in events)
+
+
+@pytest.mark.parametrize(("share", "hue"), [(0.6, 12), (0.3, 6)])
+def test_a_book_of_another_colour_in_its_place_is_never_judged_the_lost_one(share, hue):
+    anchoring, events = book_seen_again_in_colours([share] * 14, hue)
+    assert books(anchoring) == [("book_1", AnchorState.MISSING), ("book_2", AnchorState.CONFIRMED)]
+
+
+def test_colour_evidence_grows_when_known_and_at_each_doubling():
+    model, grew = None, []
+    for view in range(1, 26):
+        model = with_view(model, mug_colour(12))
+        if colour_evidence_grew(model, 3):
+            grew.append(view)
+    assert grew == [3, 6, 12, 24]
+    assert not colour_evidence_grew(model, 0) and not colour_evidence_grew(None, 3)
 
 
 def test_two_objects_seen_apart_are_never_merged(make_anchoring, maker):
