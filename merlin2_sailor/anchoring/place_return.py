@@ -97,8 +97,8 @@ def _returns(
         return False  # it was there before the jump: the jump was not away from it
     home = float(np.linalg.norm(newcomer.position - anchor.left_place))
     away = float(np.linalg.norm(newcomer.position - anchor.position))
-    return home <= place_jump / 2.0 and away > place_jump and not colours_differ(anchor.colour, newcomer.colour,
-                                                                                   colour)
+    on_the_place_left = home <= place_jump / 2.0 and away > place_jump
+    return on_the_place_left and not colours_differ(anchor.colour, newcomer.colour, colour)
 
 
 def trade_places(decision: Return) -> None:
