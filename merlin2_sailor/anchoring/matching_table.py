@@ -197,10 +197,12 @@ class MatchingTableBuilder:
         continuations &= ~gated
 
         to_score = ~gated & ~shortcut[:, np.newaxis]
-        comparable = comparable_views(columns.sizes, whole, anchors)
-        percepts, embedded = self._embed_needed(percepts, np.flatnonzero((to_score & comparable).any(axis=1)))
-        if embedded:
-            columns = PerceptColumns.from_percepts(percepts)
+        comparable, embedded = None, 0
+        if self.matcher.uses_appearance:  # only a matcher that reads the look needs to know which views show it
+            comparable = comparable_views(columns.sizes, whole, anchors)
+            percepts, embedded = self._embed_needed(percepts, np.flatnonzero((to_score & comparable).any(axis=1)))
+            if embedded:
+                columns = PerceptColumns.from_percepts(percepts)
 
         scores = np.full(shape, self.config.gated_score)
         rows, score_columns = np.nonzero(to_score)
@@ -208,8 +210,9 @@ class MatchingTableBuilder:
             features = pair_features(
                 columns, anchor_columns, rows, score_columns, self.matcher.feature_config, self.matcher.uses_appearance
             )
-            features = dataclasses.replace(
-                features, appearance_known=features.appearance_known & comparable[rows, score_columns])
+            if comparable is not None:
+                features = dataclasses.replace(
+                    features, appearance_known=features.appearance_known & comparable[rows, score_columns])
             scores[rows, score_columns] = self.matcher.score_pairs(features)
         if anchor_columns.search_radii is not None:
             searched = (anchor_columns.search_radii > 0.0)[np.newaxis, :] & to_score
