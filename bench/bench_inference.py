@@ -10,8 +10,8 @@ Three networks, each figure beside its baseline measured in the same run on the 
 
 each with 2 threads (the target machine: two cores) and 1 thread, OpenVINO in float32 (``f32``, as
 torch; the matching path's default) and in the device's fastest precision (``auto``: bfloat16 on
-CPUs with AVX-512 BF16 or AMX; the detector's default; torch and OpenCV DNN stay float32), and the
-resident memory of the
+CPUs with AVX-512 BF16 or AMX; torch and OpenCV DNN stay float32), the detector also quantised
+to int8 (its default; ``merlin2_sailor.inference.quantisation``), and the resident memory of the
 anchoring service with the learned matcher (its matcher and crop embedder built, a frame
 embedded and scored), each runtime in a fresh process, and whether that process imported torch.
 Targets (issue 16): embedding <= 5 ms/crop and >= 2.5x torch; detector <= 25 ms/frame and >= 2x
@@ -149,6 +149,13 @@ def measure_threads(result: BenchmarkResult, rows: list[list[object]], threads: 
                 lambda runtime, d=detectors: median_seconds(lambda: [d[runtime].detect(p) for p in photos], repeats)
                 / len(photos) * 1e3,
                 **({"target": "<= 25 ms/frame, >= 2x OpenCV DNN", "target_value": 25.0} if two_cores else {}))
+    # The quantised detector (its default); OpenCV DNN, float32, stays the baseline.
+    detectors = {runtime: create_detector("ssd_mobilenet", {"inference": settings(runtime, threads, "int8")})
+                 for runtime in RUNTIMES}
+    compare(result, rows, f"detector, {threads} thread(s), int8", "ms/frame",
+            lambda runtime: median_seconds(lambda: [detectors[runtime].detect(p) for p in photos], repeats)
+            / len(photos) * 1e3,
+            **({"target": "<= 25 ms/frame, >= 2x OpenCV DNN", "target_value": 25.0} if two_cores else {}))
     matchers = {runtime: create_matcher(MatcherSettings(name="network", inference=settings(runtime, threads, "f32")))
                 for runtime in RUNTIMES}
     for pairs in (20, 200):

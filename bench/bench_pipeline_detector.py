@@ -8,8 +8,10 @@ EfficientNet-Lite0). It runs twice, each run with the shipped configuration othe
 
 - old path: ``inference_runtime: native`` (OpenCV DNN for the detector, torch for the backbone and
   the network);
-- new path: ``inference_runtime: openvino`` (the exported models; each node's default precision:
-  the device's fastest for the detector, float32 for the matching path);
+- new path: ``inference_runtime: openvino`` (the exported models; the detector in the device's
+  fastest float precision, ``auto``: bfloat16 where the CPU has it; float32 for the matching path);
+- new path with the int8 detector: the same, the detector quantised (``inference_precision: int8``,
+  its default);
 - new path set for two shared cores: OpenVINO with one inference thread per node (the detector and
   the anchoring node no longer contend for both cores) and the anchoring node in the device's
   fastest precision too.
@@ -37,14 +39,18 @@ from harness.results import BenchmarkResult, Table
 OBJECTS = 10
 TARGET_PHASE = "15 Hz"
 LATENCY_TARGET_MS = 100.0
-PATHS = {"openvino": "new path (OpenVINO)", "native": "old path (OpenCV DNN + torch)",
-         "openvino_2cores": "new path, 1 thread per node, anchoring in auto precision"}
+PATHS = {"openvino_int8": "new path, int8 detector", "openvino": "new path (OpenVINO), auto-precision detector",
+         "native": "old path (OpenCV DNN + torch)",
+         "openvino_2cores": "new path, int8 detector, 1 thread per node, anchoring in auto precision"}
 #: (anchoring parameters, detector parameters) of each path, over the shipped configuration.
 PATH_PARAMETERS = {
-    "openvino": ((("inference_runtime", "openvino"),), (("inference_runtime", "openvino"),)),
+    "openvino_int8": ((("inference_runtime", "openvino"),),
+                      (("inference_runtime", "openvino"), ("inference_precision", "int8"))),
+    "openvino": ((("inference_runtime", "openvino"),),
+                 (("inference_runtime", "openvino"), ("inference_precision", "auto"))),
     "native": ((("inference_runtime", "native"),), (("inference_runtime", "native"),)),
     "openvino_2cores": ((("inference_runtime", "openvino"), ("inference_threads", 1), ("inference_precision", "auto")),
-                        (("inference_runtime", "openvino"), ("inference_threads", 1))),
+                        (("inference_runtime", "openvino"), ("inference_threads", 1), ("inference_precision", "int8"))),
 }
 
 
@@ -107,7 +113,7 @@ def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None
                                   round(trend.peak_mb, 1)])
         if "native" not in figures:
             continue
-        for path in ("openvino", "openvino_2cores"):
+        for path in ("openvino_int8", "openvino", "openvino_2cores"):
             if path in figures:
                 add_figures(result, phase.label, path, figures[path], figures["native"])
     result.tables.append(Table(

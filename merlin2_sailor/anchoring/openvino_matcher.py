@@ -63,6 +63,7 @@ class OpenVinoNetworkMatcher(PairNetworkMatcher):
 
     def __init__(self, exported: ExportedModel, settings: InferenceSettings,
                  config: NetworkMatcherConfig | None = None, report: Callable[[str], None] | None = None) -> None:
+        settings.require_float("matching network")
         try:
             metadata = NetworkMetadata(**exported.metadata["network"])
         except (KeyError, TypeError) as error:

@@ -19,10 +19,11 @@ from merlin2_sailor.inference.model_cache import CACHE_VARIABLE, ExportedModel, 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "export-models", help="export the detector, the crop backbone and the matching network for OpenVINO",
-        description="Convert the SSD-MobileNet graph, the EfficientNet-Lite0 crop backbone and the matching "
-                    "network's weights (the shipped ones, or --weights) into OpenVINO models in the model "
-                    f"cache (${CACHE_VARIABLE}, else ~/.cache/merlin2_sailor/models). Needs torch for the "
-                    "backbone and the network; what is already exported is skipped.",
+        description="Convert the SSD-MobileNet graph (in float and quantised to int8), the EfficientNet-Lite0 "
+                    "crop backbone and the matching network's weights (the shipped ones, or --weights) into "
+                    f"OpenVINO models in the model cache (${CACHE_VARIABLE}, else "
+                    "~/.cache/merlin2_sailor/models). Needs torch for the backbone and the network, NNCF for "
+                    "the int8 detector; what is already exported is skipped.",
     )
     parser.add_argument("--output", type=Path, default=None, metavar="FOLDER",
                         help=f"the model cache to write (default: {cache_folder()})")
@@ -43,6 +44,7 @@ def run(arguments: argparse.Namespace) -> int:
     from merlin2_sailor.perception.ssd_mobilenet import (
         SsdMobileNetConfig,
         ensure_openvino_detector,
+        ensure_quantised_detector,
         locate_model_directory,
     )
 
@@ -53,6 +55,8 @@ def run(arguments: argparse.Namespace) -> int:
     steps: list[tuple[str, Callable[[], ExportedModel]]] = [
         ("SSD-MobileNet-v2 COCO detector",
          lambda: ensure_openvino_detector(locate_model_directory(), SsdMobileNetConfig().input_size, folder)),
+        ("SSD-MobileNet-v2 COCO detector in int8 (NNCF)",
+         lambda: ensure_quantised_detector(locate_model_directory(), SsdMobileNetConfig().input_size, folder)),
         (f"{backbone} crop backbone",
          lambda: ensure_backbone(backbone, lambda: BACKBONES.create(backbone, arguments.backbone_weights),
                                  arguments.backbone_weights, folder)),

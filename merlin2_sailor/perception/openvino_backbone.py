@@ -65,6 +65,7 @@ class OpenVinoBackbone(Backbone):
 
     def __init__(self, exported: ExportedModel, settings: InferenceSettings,
                  report: Callable[[str], None] | None = None) -> None:
+        settings.require_float("crop backbone")
         metadata = exported.metadata
         self.name = str(metadata["backbone"])
         self.feature_dimension = int(metadata["feature_dimension"])

