@@ -7,11 +7,12 @@ scores every new crop with the learned matching function (``matcher: network``, 
 EfficientNet-Lite0). It runs twice, each run with the shipped configuration otherwise:
 
 - old path: ``inference_runtime: native`` (OpenCV DNN for the detector, torch for the backbone and
-  the network);
+  the network), every crop embedded (no crop reuse);
 - new path: ``inference_runtime: openvino`` (the exported models; the detector in the device's
   fastest float precision, ``auto``: bfloat16 where the CPU has it; float32 for the matching path);
 - new path with the int8 detector: the same, the detector quantised (``inference_precision: int8``,
-  its default);
+  its default); and once more with the anchoring node's crop reuse off (``crop_reuse_tolerance: 0``:
+  every crop embedded, as before ``merlin2_sailor.perception.crop_reuse``);
 - new path set for two shared cores: OpenVINO with one inference thread per node (the detector and
   the anchoring node no longer contend for both cores) and the anchoring node in the device's
   fastest precision too.
@@ -39,16 +40,19 @@ from harness.results import BenchmarkResult, Table
 OBJECTS = 10
 TARGET_PHASE = "15 Hz"
 LATENCY_TARGET_MS = 100.0
-PATHS = {"openvino_int8": "new path, int8 detector", "openvino": "new path (OpenVINO), auto-precision detector",
-         "native": "old path (OpenCV DNN + torch)",
+PATHS = {"openvino_int8": "new path, int8 detector", "openvino_int8_no_reuse": "new path, int8 detector, no crop reuse",
+         "openvino": "new path (OpenVINO), auto-precision detector",
+         "native": "old path (OpenCV DNN + torch, no crop reuse)",
          "openvino_2cores": "new path, int8 detector, 1 thread per node, anchoring in auto precision"}
 #: (anchoring parameters, detector parameters) of each path, over the shipped configuration.
 PATH_PARAMETERS = {
     "openvino_int8": ((("inference_runtime", "openvino"),),
                       (("inference_runtime", "openvino"), ("inference_precision", "int8"))),
+    "openvino_int8_no_reuse": ((("inference_runtime", "openvino"), ("crop_reuse_tolerance", 0.0)),
+                               (("inference_runtime", "openvino"), ("inference_precision", "int8"))),
     "openvino": ((("inference_runtime", "openvino"),),
                  (("inference_runtime", "openvino"), ("inference_precision", "auto"))),
-    "native": ((("inference_runtime", "native"),), (("inference_runtime", "native"),)),
+    "native": ((("inference_runtime", "native"), ("crop_reuse_tolerance", 0.0)), (("inference_runtime", "native"),)),
     "openvino_2cores": ((("inference_runtime", "openvino"), ("inference_threads", 1), ("inference_precision", "auto")),
                         (("inference_runtime", "openvino"), ("inference_threads", 1), ("inference_precision", "int8"))),
 }
@@ -113,7 +117,7 @@ def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None
                                   round(trend.peak_mb, 1)])
         if "native" not in figures:
             continue
-        for path in ("openvino_int8", "openvino", "openvino_2cores"):
+        for path in ("openvino_int8", "openvino_int8_no_reuse", "openvino", "openvino_2cores"):
             if path in figures:
                 add_figures(result, phase.label, path, figures[path], figures["native"])
     result.tables.append(Table(

@@ -40,7 +40,9 @@ class MatcherSettings:
     shipped ones); ``backbone``: the crop backbone the weights were trained with, which the
     embedder runs; ``rules``: the rule matcher's tolerances, also the network's fallback for pairs
     it cannot score (no embedding); ``inference``: the runtime, device and threads the network and
-    the crop backbone run with.
+    the crop backbone run with; ``crop_reuse_tolerance``: grey levels under which a crop takes the
+    embedding of a recent crop showing the same pixels, 0 to embed every crop
+    (:mod:`merlin2_sailor.perception.crop_reuse`, whose default this is).
     """
 
     name: str = "rules"
@@ -48,6 +50,7 @@ class MatcherSettings:
     backbone: str = DEFAULT_BACKBONE
     rules: RuleMatcherConfig = field(default_factory=RuleMatcherConfig)
     inference: InferenceSettings = field(default_factory=InferenceSettings)
+    crop_reuse_tolerance: float = 2.0
 
     def __post_init__(self) -> None:
         if self.name not in MATCHER_ENTRIES:
@@ -116,10 +119,13 @@ def create_matcher(settings: MatcherSettings, report: Callable[[str], None] | No
 
 
 def create_embedder(settings: MatcherSettings, report: Callable[[str], None] | None = None) -> Embedder:
-    """The crop embedder running ``settings.backbone`` on ``settings.inference``'s runtime."""
+    """The crop embedder running ``settings.backbone`` on ``settings.inference``'s runtime, reusing
+    the embedding of a recent crop that shows the same pixels (``settings.crop_reuse_tolerance``)."""
+    from merlin2_sailor.perception.crop_reuse import CropReuseConfig, ReusingEmbedder
     from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
 
-    return CropEmbedder(EmbeddingConfig(backbone=settings.backbone, inference=settings.inference), report=report)
+    embedder = CropEmbedder(EmbeddingConfig(backbone=settings.backbone, inference=settings.inference), report=report)
+    return ReusingEmbedder(embedder, CropReuseConfig(tolerance=settings.crop_reuse_tolerance))
 
 
 def create_matching(settings: MatcherSettings, embed: bool = True,

@@ -226,6 +226,10 @@ SETTINGS: tuple[Setting, ...] = (
                 "OpenVINO precision: f32 (as torch: the scores the weights were validated with) or auto (the "
                 "device's fastest: bfloat16 where the CPU has it, about twice as fast; match scores then move "
                 "by up to 0.05).", choices=PRECISIONS),
+        Setting("crop_reuse_tolerance", ("matcher", "crop_reuse_tolerance"),
+                "Grey levels (mean difference of 16 x 16 thumbnails) under which a crop takes the embedding "
+                "of a crop of the same size embedded in the last 3 frames: a still camera's untracked "
+                "detections are not embedded anew every frame; 0 embeds every crop.", 0.0, 50.0),
     ),
     *_group(
         "Rule matcher (also the network's fallback for pairs without an embedding)",

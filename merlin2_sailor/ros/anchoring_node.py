@@ -125,7 +125,8 @@ class AnchoringNode(Node):
         self._anchoring_thread = threading.Thread(target=self._anchor_frames, name="anchoring", daemon=True)
         self._anchoring_thread.start()
         self._reported_drops = 0
-        self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report_drops)
+        self._reported_embedding = (0, 0)
+        self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report)
 
         self.service.start()
         self._publish_state()
@@ -190,6 +191,21 @@ class AnchoringNode(Node):
                 self._anchor_frame(message)
             except Exception as error:  # noqa: BLE001 - one frame must not stop anchoring
                 self.get_logger().error(f"frame dropped: anchoring failed: {error!r}")
+
+    def _report(self) -> None:
+        self._report_drops()
+        self._report_embedding()
+
+    def _report_embedding(self) -> None:
+        """How many crops the last period embedded, and how many took a recent crop's embedding."""
+        embedder = self.service.embedder
+        counts = (getattr(embedder, "embedded", None), getattr(embedder, "reused", None))
+        if counts[0] is None or counts[1] is None or counts == self._reported_embedding:
+            return
+        embedded, reused = counts[0] - self._reported_embedding[0], counts[1] - self._reported_embedding[1]
+        self._reported_embedding = counts
+        self.get_logger().info(f"crops in the last {DROP_REPORT_PERIOD_SECONDS:g} s: {embedded} embedded, {reused} "
+                               "took the embedding of the same view a moment before")
 
     def _report_drops(self) -> None:
         dropped = self._mailbox.dropped
