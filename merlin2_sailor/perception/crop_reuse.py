@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+import cv2
 import numpy as np
 
 from merlin2_sailor.errors import ConfigurationError
@@ -137,8 +138,6 @@ class ReusingEmbedder:
 
 def thumbnail(crop: np.ndarray) -> np.ndarray:
     """A crop's 16 x 16 area-averaged thumbnail, flattened (float32 grey levels, three channels)."""
-    import cv2
-
     image = np.ascontiguousarray(crop)
     if image.ndim == 2:
         image = np.repeat(image[:, :, np.newaxis], 3, axis=2)

@@ -139,13 +139,14 @@ def ensure_quantised_detector(directory: Path, input_size: int, folder: Path | N
                               report: Callable[[str], None] | None = None) -> ExportedModel:
     """The converted graph quantised to int8 (NNCF, calibrated on :mod:`.detector_calibration`'s
     photos; :data:`FLOAT_SCOPES` stay float), quantising it first when missing (about 30 s on two cores)."""
-    converted = ensure_openvino_detector(directory, input_size, folder, report)
     graph = directory / GRAPH_FILE
     calibration = f"calibration v{CALIBRATION_VERSION}, {CALIBRATION_IMAGES} images, float {FLOAT_SCOPES}"
 
     def write(target: Path) -> dict[str, object]:
         import openvino
 
+        # Only quantising needs the float model: a cached int8 one is found without it.
+        converted = ensure_openvino_detector(directory, input_size, folder, report)
         model = openvino_core().read_model(str(converted.model_path))
         images = calibration_images(input_size)
         openvino.save_model(quantise(model, images, FLOAT_SCOPES), str(target / MODEL_FILE), compress_to_fp16=False)
