@@ -20,7 +20,7 @@ import numpy as np
 from merlin2_sailor.anchoring.colour_evidence import ColourModel, combined, with_view
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
-from merlin2_sailor.anchoring.gallery import add_to_gallery, from_bfloat16_bits
+from merlin2_sailor.anchoring.gallery import add_view, from_bfloat16_bits
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
 
@@ -36,6 +36,11 @@ class AnchorState(Enum):
     """Should have been seen (in view, not occluded) and was not; kept a while, in case."""
     FORGOTTEN = "forgotten"
     """Missing too long or forgotten on request; no longer anchored."""
+
+
+def view_scale(percept: Percept) -> float:
+    """The size of a view in pixels: the square root of its box's area (0 for an empty box)."""
+    return math.sqrt(max(percept.box.width, 0.0) * max(percept.box.height, 0.0))
 
 
 def _zero_vector() -> np.ndarray:
@@ -63,6 +68,9 @@ class Anchor:
     gallery: np.ndarray | None = None
     """(n, D) recent appearance embeddings as bfloat16 bits (:mod:`.gallery`), newest last; None
     before any was available."""
+    gallery_scales: np.ndarray | None = None
+    """(n,) the size in pixels (square root of the box's area) of each view in ``gallery``; NaN
+    where unknown (restored from an older snapshot). See :mod:`.far_view`."""
     colour: ColourModel | None = None
     """The colours of its whole views' own pixels (:mod:`.colour_evidence`); None before any."""
     colour_seen: float | None = None
@@ -116,7 +124,7 @@ class Anchor:
         """Acquire: a new, tentative anchor initialised from one percept; from a ``partial`` view,
         so uncertain that the first whole view takes its place."""
         position = np.array(percept.position, dtype=np.float64)
-        return cls(
+        anchor = cls(
             symbol=symbol,
             class_name=percept.class_name,
             position=position,
@@ -127,12 +135,15 @@ class Anchor:
             class_votes=vote_class({}, percept.class_name, percept.score),
             position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
             whole_views=0 if partial else 1,
-            gallery=None if embedding is None or partial else add_to_gallery(None, embedding, config.gallery_size),
             colour=None if partial else with_view(None, percept.colour),
             colour_seen=None if partial or percept.colour is None else percept.stamp,
             visible=True,
             perceived_position=position.copy(),
         )
+        if embedding is not None and not partial:
+            anchor.gallery, anchor.gallery_scales = add_view(None, None, embedding, view_scale(percept),
+                                                             config.gallery_size)
+        return anchor
 
     def absorb(
         self, percept: Percept, embedding: np.ndarray | None, config: FusionConfig, partial: bool = False
@@ -160,7 +171,8 @@ class Anchor:
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
         if embedding is not None and not partial:  # a part's look is not the object's (matching_table)
-            self.gallery = add_to_gallery(self.gallery, embedding, config.gallery_size)
+            self.gallery, self.gallery_scales = add_view(self.gallery, self.gallery_scales, embedding,
+                                                         view_scale(percept), config.gallery_size)
         if percept.tracker_id:
             self.last_tracker_id = percept.tracker_id
         self.last_seen = max(self.last_seen, percept.stamp)
@@ -188,8 +200,12 @@ class Anchor:
             self.class_votes[class_name] = self.class_votes.get(class_name, 0.0) + votes
         self.class_name = winning_class(self.class_votes, self.class_name)
         if other.gallery is not None:
-            for view in from_bfloat16_bits(other.gallery):
-                self.gallery = add_to_gallery(self.gallery, view, config.gallery_size)
+            scales = other.gallery_scales
+            if scales is None or len(scales) != len(other.gallery):
+                scales = np.full(len(other.gallery), np.nan)
+            for view, scale in zip(from_bfloat16_bits(other.gallery), scales, strict=True):
+                self.gallery, self.gallery_scales = add_view(self.gallery, self.gallery_scales, view, float(scale),
+                                                             config.gallery_size)
         self.colour = combined(self.colour, other.colour)
         self.times_seen += other.times_seen
         self.last_seen = max(self.last_seen, other.last_seen)

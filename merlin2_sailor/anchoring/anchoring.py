@@ -5,7 +5,9 @@ One frame (:meth:`Anchoring.process`) follows the paper's algorithm, then the li
 1. anchors missing for too long are forgotten (:mod:`.unseen`);
 2. with no anchors, every percept is acquired; otherwise the matching table (gated, batched,
    :mod:`.matching_table`) is built and assigned (:mod:`.assignment`): a pair at or above
-   ``match_threshold`` reacquires, every other percept acquires a new anchor (:mod:`.observation`);
+   ``match_threshold`` reacquires, every other percept acquires a new anchor (:mod:`.observation`),
+   unless it is a view too far to tell from an anchor not seen otherwise (:mod:`.far_view`): that
+   one is left unresolved;
 3. an anchor not reacquired is checked against the camera: only if it should have been visible
    does it count towards MISSING; an expected place seen empty has its expectation RETRACTED;
 4. identity repair (:mod:`.identity_repair`): a newcomer that is a MISSING anchor seen again, by
@@ -31,6 +33,7 @@ from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colour_evidence_grew
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.far_view import FarViewConfig, unresolved_far_views
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
@@ -71,7 +74,9 @@ class AnchoringConfig:
     ``repair``: when a newer anchor is a lost one seen again (:mod:`.identity_repair`);
     ``colour``: when colours rule out that a view or an anchor is another anchor's object
     (:mod:`.colour_evidence`), in the matching table and in every merge; ``watch``: where the
-    camera has watched, so that an object first seen there arrived (:mod:`.watched_places`).
+    camera has watched, so that an object first seen there arrived (:mod:`.watched_places`);
+    ``far_view``: when a view too small to compare with an anchor's is left unresolved
+    (:mod:`.far_view`).
     """
 
     match_threshold: float = 0.5
@@ -85,6 +90,7 @@ class AnchoringConfig:
     lifecycle: LifecycleConfig = field(default_factory=LifecycleConfig)
     visibility: VisibilityConfig = field(default_factory=VisibilityConfig)
     watch: WatchConfig = field(default_factory=WatchConfig)
+    far_view: FarViewConfig = field(default_factory=FarViewConfig)
     index: IndexConfig = field(default_factory=IndexConfig)
 
     def __post_init__(self) -> None:
@@ -210,6 +216,9 @@ class Anchoring:
             symbols[row] = anchor.symbol
 
         unmatched = [int(row) for row in assignment.unmatched_percepts]
+        unresolved = unresolved_far_views(table, unmatched, [column for _, column in assignment.matches],
+                                          config.match_threshold, config.far_view)
+        unmatched = [row for row in unmatched if row not in unresolved]
         percepts = self._embed_for_gallery(percepts, [row for row in unmatched if not partial[row]])
         # New anchors of one class in one frame take their symbols in the order of their places, not
         # of the detector's list (which a detector may shuffle): the same frames give the same
@@ -228,14 +237,17 @@ class Anchoring:
         self._watched.watch(percepts, unknown, camera)
         seen = set(symbols)
         if camera is not None:
-            check_unseen(self._index, camera, seen, changes, config.visibility, config.lifecycle)
+            # An anchor a far view may have been is not unseen: whether it was there cannot be told.
+            told_apart = seen | {anchor.symbol for anchor in unresolved.values()}
+            check_unseen(self._index, camera, told_apart, changes, config.visibility, config.lifecycle)
         renamed = self._repair_identities(changes)
         symbols = [renamed.get(symbol, symbol) for symbol in symbols]
         seen = {renamed.get(symbol, symbol) for symbol in seen}
         for anchor in previously_visible:
             if anchor.symbol not in seen:
                 anchor.visible = False
-        return changes.result(symbols)
+        may_be = tuple(renamed.get(anchor.symbol, anchor.symbol) for anchor in unresolved.values())
+        return changes.result(symbols, may_be)
 
     def track(self, stamp: float, robot_pose: Pose | None = None) -> AnchoringResult:
         """Extend anchors without observation and apply the lifecycle's time-outs.

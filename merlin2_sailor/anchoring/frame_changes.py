@@ -12,7 +12,9 @@ from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 
 @dataclass(frozen=True, slots=True, eq=False)
 class AnchoringResult:
-    """What one call changed. ``percept_symbols[i]`` is the symbol percept i was anchored to."""
+    """What one call changed. ``percept_symbols[i]`` is the symbol percept i was anchored to, or ""
+    for a percept left unresolved (:mod:`.far_view`); ``unresolved`` names, per such percept, the
+    anchor it may have been."""
 
     stamp: float
     acquired: tuple[Anchor, ...] = ()
@@ -21,6 +23,7 @@ class AnchoringResult:
     forgotten: tuple[Anchor, ...] = ()
     events: tuple[AnchorEvent, ...] = ()
     percept_symbols: tuple[str, ...] = ()
+    unresolved: tuple[str, ...] = ()
 
 
 @dataclass(slots=True)
@@ -40,7 +43,7 @@ class FrameChanges:
     def event(self, kind: AnchorEventKind, symbol: str, **details: Any) -> None:
         self.events.append(AnchorEvent(kind, symbol, self.stamp, details))
 
-    def result(self, percept_symbols: Sequence[str] = ()) -> AnchoringResult:
+    def result(self, percept_symbols: Sequence[str] = (), unresolved: Sequence[str] = ()) -> AnchoringResult:
         return AnchoringResult(
             self.stamp,
             tuple(self.acquired),
@@ -49,4 +52,5 @@ class FrameChanges:
             tuple(self.forgotten),
             tuple(self.events),
             tuple(percept_symbols),
+            tuple(unresolved),
         )

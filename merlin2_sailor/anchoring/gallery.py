@@ -43,6 +43,20 @@ def add_to_gallery(gallery: np.ndarray | None, embedding: np.ndarray, size: int)
     return np.concatenate((gallery[max(0, len(gallery) - size + 1) :], row))
 
 
+def add_view(
+    gallery: np.ndarray | None, scales: np.ndarray | None, embedding: np.ndarray, scale: float, size: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`add_to_gallery`, keeping beside the gallery the size in pixels of each view's box
+    (``scale``: the square root of its area; NaN where unknown, as for a gallery restored from a
+    snapshot that did not keep sizes). A view much smaller than every view in a gallery is weak
+    evidence against it (:mod:`.far_view`), so the sizes go where the views go."""
+    kept = 0 if gallery is None else len(gallery)
+    old = scales if scales is not None and len(scales) == kept else np.full(kept, np.nan)
+    new_gallery = add_to_gallery(gallery, embedding, size)
+    new_scales = np.append(np.asarray(old, dtype=np.float32), np.float32(scale))[-len(new_gallery):]
+    return new_gallery, new_scales
+
+
 def gallery_similarity(first: np.ndarray, second: np.ndarray) -> float:
     """The best cosine similarity between any view of one gallery and any view of the other."""
     a = from_bfloat16_bits(first).astype(np.float64)

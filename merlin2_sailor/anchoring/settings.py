@@ -378,6 +378,14 @@ SETTINGS: tuple[Setting, ...] = (
                 "Seconds an anchor's colour must have gone unchecked (no whole view with a colour) before "
                 "one whole view of another colour rules out that it is the anchor's object (a look-alike "
                 "put in its place while the camera looked away); 0: always.", 0.0, 1e6),
+        Setting("far_view_scale_ratio", ("core", "far_view", "scale_ratio"),
+                "A view whose box (square root of its area) is under this share of every view in an anchor's "
+                "appearance gallery is too far to compare with it: unmatched, it is left unresolved (no new "
+                "anchor) rather than anchored anew, if that anchor scored it at least far_view_score_floor and "
+                "nothing else reacquired it (appearance matchers only; 0 turns it off).", 0.0, 0.99),
+        Setting("far_view_score_floor", ("core", "far_view", "score_floor"),
+                "A matching score under this is a firm \"another object\", acted on whatever the view's size.",
+                0.0, 0.99),
     ),
     *_group(
         "Spatial index (performance only)",

@@ -37,6 +37,10 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
             "shape": list(anchor.gallery.shape),
             "bfloat16_base64": base64.b64encode(anchor.gallery.astype(_GALLERY_BYTE_ORDER).tobytes()).decode("ascii"),
         }
+        scales = anchor.gallery_scales
+        if scales is not None and len(scales) == len(anchor.gallery):
+            # JSON has no NaN: an unknown size travels as null.
+            gallery["view_scales"] = [None if np.isnan(scale) else float(scale) for scale in scales]
     return {
         "symbol": anchor.symbol,
         "class_name": anchor.class_name,
@@ -86,6 +90,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             class_votes={str(k): float(v) for k, v in dict(data.get("class_votes") or {}).items()},
             position_variance=float(data["position_variance"]),
             gallery=_gallery(data.get("gallery")),
+            gallery_scales=_gallery_scales(data.get("gallery")),
             colour=_colour(data.get("colour")),
             colour_seen=None if data.get("colour_seen") is None else float(data["colour_seen"]),
             colour_disputed=bool(data.get("colour_disputed", False)),
@@ -127,6 +132,16 @@ def _colour(data: Mapping[str, Any] | None) -> ColourModel | None:
             or not (np.all(np.isfinite(mean)) and np.all(np.isfinite(squares))):
         raise ValueError(f"colour must hold views >= 1 and {COLOUR_BINS} finite means and squares")
     return ColourModel(views, mean, squares)
+
+
+def _gallery_scales(data: Mapping[str, Any] | None) -> np.ndarray | None:
+    """The sizes of a snapshot's gallery views (None in snapshots written before they were kept)."""
+    if data is None or data.get("view_scales") is None:
+        return None
+    scales = np.array([np.nan if scale is None else float(scale) for scale in data["view_scales"]], dtype=np.float32)
+    if len(scales) != int(data["shape"][0]) or np.any(scales[~np.isnan(scales)] < 0.0):
+        raise ValueError(f"view_scales must hold one size >= 0 (or null) per gallery view, got {data['view_scales']!r}")
+    return scales
 
 
 def _gallery(data: Mapping[str, Any] | None) -> np.ndarray | None:

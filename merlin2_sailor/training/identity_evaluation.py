@@ -30,7 +30,8 @@ from merlin2_sailor.training.generated_scenes import Scene
 @dataclass(frozen=True, slots=True)
 class IdentityMetrics:
     """Over all scenes: ``instances`` (ground-truth objects), ``anchors`` (symbols created; equal
-    to ``instances`` when nothing was split), ``id_switches``, ``idf1`` / ``idp`` / ``idr``, ``mota``."""
+    to ``instances`` when nothing was split), ``id_switches``, ``idf1`` / ``idp`` / ``idr``, ``mota``,
+    and ``unresolved``: percepts left without a symbol (views too far to tell)."""
 
     scenes: int
     percepts: int
@@ -41,6 +42,7 @@ class IdentityMetrics:
     idp: float
     idr: float
     mota: float
+    unresolved: int = 0
 
     def as_dict(self) -> dict[str, float | int]:
         return asdict(self)
@@ -66,7 +68,7 @@ def evaluate_identities(
     """Replay ``scenes`` through a fresh Anchoring each (matcher from ``matcher_factory``)."""
     motmetrics = motmetrics_module()
     accumulators, names = [], []
-    percept_count = instances = anchors = 0
+    percept_count = instances = anchors = unresolved = 0
     for scene in scenes:
         matcher = matcher_factory()
         anchoring = Anchoring(config, matcher)
@@ -94,9 +96,13 @@ def evaluate_identities(
             ]
             result = anchoring.process(percepts, None, sample.stamp)
             truth = [o.instance for o in observations]
-            hypotheses = [symbol_numbers.setdefault(s, len(symbol_numbers)) for s in result.percept_symbols]
+            # A percept left unresolved (a view too far to tell, merlin2_sailor.anchoring.far_view) names no anchor:
+            # its object counts as missed in that frame, never as a symbol.
+            named = [row for row, symbol in enumerate(result.percept_symbols) if symbol]
+            hypotheses = [symbol_numbers.setdefault(result.percept_symbols[row], len(symbol_numbers)) for row in named]
             distances = np.full((len(truth), len(hypotheses)), np.nan)
-            np.fill_diagonal(distances, 0.0)
+            distances[named, np.arange(len(named))] = 0.0
+            unresolved += len(truth) - len(named)
             accumulator.update(truth, hypotheses, distances)
             instances_seen.update(truth)
             percept_count += len(observations)
@@ -120,6 +126,7 @@ def evaluate_identities(
         idp=float(overall["idp"]),
         idr=float(overall["idr"]),
         mota=float(overall["mota"]),
+        unresolved=unresolved,
     )
 
 
@@ -127,11 +134,11 @@ def format_identity_table(rows: dict[str, IdentityMetrics]) -> str:
     width = max([len(name) for name in rows] + [8])
     lines = [
         f"{'':<{width}}  {'percepts':>8} {'objects':>8} {'anchors':>8} {'ID sw.':>7} "
-        f"{'IDF1':>7} {'IDP':>7} {'IDR':>7} {'MOTA':>7}"
+        f"{'IDF1':>7} {'IDP':>7} {'IDR':>7} {'MOTA':>7} {'unresolved':>10}"
     ]
     for name, m in rows.items():
         lines.append(
             f"{name:<{width}}  {m.percepts:>8d} {m.instances:>8d} {m.anchors:>8d} {m.id_switches:>7d} "
-            f"{m.idf1:>7.4f} {m.idp:>7.4f} {m.idr:>7.4f} {m.mota:>7.4f}"
+            f"{m.idf1:>7.4f} {m.idp:>7.4f} {m.idr:>7.4f} {m.mota:>7.4f} {m.unresolved:>10d}"
         )
     return "\n".join(lines)

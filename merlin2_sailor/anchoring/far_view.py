@@ -1,0 +1,92 @@
+"""A view too far to tell: left unresolved instead of becoming a new anchor.
+
+Why. An appearance matcher compares a percept's crop with the anchor's gallery of recent views.
+When the percept's box is much smaller than every view the gallery holds (the object seen again
+from across a room, after close views), its crop is a blurred, upsampled copy of what the
+gallery saw sharp, and the comparison says little. Measured on the 10 held-out houses of the
+house source (3 December 2026, same-class pairs of Algorithm 3, the shipped weights): where the
+percept's box is under half the size of the anchor's largest view, the network rejects 5.7-6.8 %
+of true pairs against 1.4-1.9 % at comparable sizes, and replaying the houses through the
+anchoring layer, 10 of the network's 16 split objects were such views of an object at its own
+place (0.08-0.17 m) after 10-94 s away, scored 0.09-0.47. In the simulated house the same thing
+made the hall mug a second anchor, on its own spot, as the robot left the hall
+(`lookalike_added`, seed 0): a look-alike added beside it later took the first symbol.
+
+What it does. An unmatched percept is *unresolved* (no anchor acquired, its symbol empty) when an
+anchor of its class that no percept of this frame reacquired scored it at least ``score_floor``
+(not a firm "another object") and every view in that anchor's gallery is more than
+``1 / scale_ratio`` times the percept's size. The anchor is then not counted as unseen in that
+frame either (something of its class stood where it was; whether it was the anchor could not be
+told). A closer view decides: matched, it is reacquired; rejected at a comparable size, it becomes
+a new anchor. Nothing is guessed: a removed or replaced object seen only from afar is neither
+reported found nor anchored anew, it stays unknown until a view can tell. A firm rejection
+(below ``score_floor``) is acted on at any size, and a matcher without appearance (the rules,
+whose anchors have no gallery) is never affected.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, view_scale
+from merlin2_sailor.anchoring.matching_table import MatchingTable
+from merlin2_sailor.errors import ConfigurationError
+
+
+@dataclass(frozen=True, slots=True)
+class FarViewConfig:
+    """``scale_ratio``: a view is far from an anchor's views when its size (square root of its box's
+    area, pixels) is under this share of every view in the anchor's gallery (0 turns the whole
+    mechanism off); ``score_floor``: a matching score below it is a firm "another object",
+    acted on whatever the view's size."""
+
+    scale_ratio: float = 0.5
+    score_floor: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.scale_ratio) and 0.0 <= self.scale_ratio < 1.0):
+            raise ConfigurationError(f"far_view scale_ratio must be in [0, 1), got {self.scale_ratio}.")
+        if not (math.isfinite(self.score_floor) and 0.0 <= self.score_floor < 1.0):
+            raise ConfigurationError(f"far_view score_floor must be in [0, 1), got {self.score_floor}.")
+
+
+def unresolved_far_views(
+    table: MatchingTable, unmatched: Sequence[int], matched_columns: Sequence[int], match_threshold: float,
+    config: FarViewConfig,
+) -> dict[int, Anchor]:
+    """{percept row: the anchor it may be} for the ``unmatched`` percepts too far to tell from an
+    anchor that no percept reacquired (``matched_columns``: the table's columns reacquired)."""
+    if config.scale_ratio <= 0.0 or not unmatched or not table.anchors:
+        return {}
+    taken = set(int(column) for column in matched_columns)
+    smallest_views = np.array([_smallest_view(anchor) for anchor in table.anchors])
+    unresolved: dict[int, Anchor] = {}
+    for row in unmatched:
+        percept = table.percepts[row]
+        size = view_scale(percept)
+        if size <= 0.0:
+            continue
+        scores = table.scores[row]
+        candidates = [
+            column for column, anchor in enumerate(table.anchors)
+            if column not in taken and not table.gated[row, column] and anchor.class_name == percept.class_name
+            and config.score_floor <= scores[column] < match_threshold
+            and size < config.scale_ratio * smallest_views[column]
+        ]
+        if candidates:
+            unresolved[int(row)] = table.anchors[max(candidates, key=lambda column: scores[column])]
+    return unresolved
+
+
+def _smallest_view(anchor: Anchor) -> float:
+    """The size of the smallest view in the anchor's gallery; 0 when any is unknown or there is
+    none (nothing then says the percept is far from all of them)."""
+    scales = anchor.gallery_scales
+    if anchor.gallery is None or scales is None or len(scales) == 0 or len(scales) != len(anchor.gallery) \
+            or np.any(np.isnan(scales)):
+        return 0.0
+    return float(np.min(scales))
