@@ -58,7 +58,8 @@ def test_a_far_view_left_unresolved_is_counted_as_such_and_makes_no_anchor() -> 
     scene = Scene("one mug", "test", 0, tuple(Sample(o.stamp, Pose.identity(), (o,)) for o in observations))
 
     unresolved = evaluate_identities(LookOnly, [scene], cache)
-    anchored_anew = evaluate_identities(LookOnly, [scene], cache, AnchoringConfig(far_view=FarViewConfig(scale_ratio=0.0)))
+    turned_off = AnchoringConfig(far_view=FarViewConfig(scale_ratio=0.0))
+    anchored_anew = evaluate_identities(LookOnly, [scene], cache, turned_off)
 
     assert (unresolved.anchors, unresolved.unresolved, unresolved.id_switches) == (1, 1, 0)
     assert (anchored_anew.anchors, anchored_anew.unresolved) == (2, 0)
