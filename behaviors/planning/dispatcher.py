@@ -138,6 +138,16 @@ class Dispatcher:
                         tuple(executed),
                         tuple(plans),
                     )
+                vanished = vanished_objects(self._store, goals)
+                if vanished:
+                    return MissionResult(
+                        MissionStatus.FAILED,
+                        f"the goals name {', '.join(vanished)}, which the knowledge base no longer "
+                        "holds (an anchor forgotten, or merged into another): no plan can reach them"
+                        + (f" (after: {reason})" if reason else ""),
+                        tuple(executed),
+                        tuple(plans),
+                    )
                 task = task_from_store(self._store, goals, self._behaviours.keys())
                 planned = self._planner.plan(task)
                 if planned.status is not PlanningStatus.SOLVED or planned.plan is None:
@@ -339,3 +349,15 @@ def step_was_cancelled(behaviour: Behaviour | None) -> bool:
     """Whether the behaviour was cancelled during its run (states and machines say so)."""
     is_canceled = getattr(behaviour, "is_canceled", None)
     return bool(is_canceled()) if callable(is_canceled) else False
+
+
+def vanished_objects(store: KnowledgeBase, goals: Sequence[Proposition]) -> list[str]:
+    """The objects ``goals`` name that the knowledge base does not hold (any more).
+
+    An anchor merged into another, or forgotten, takes its object and every fact naming it out
+    of the knowledge base while a mission may still aim at it; a problem naming it cannot be
+    planned (the PDDL reader refuses an undeclared object), so the mission ends with the reason.
+    """
+    named = {name for goal in goals for name in goal.objects}
+    held = {pddl_object.name for pddl_object in store.objects.get_all()}
+    return sorted(named - held)

@@ -84,11 +84,18 @@ class EffectWriter:
         return AppliedEffects(tuple(added), tuple(deleted))
 
     def undo(self, applied: AppliedEffects) -> None:
-        """Take back effects of a step that failed, leaving alone what others changed since."""
+        """Take back effects of a step that failed, leaving alone what others changed since
+        (a fact naming an object that left the knowledge base meanwhile, an anchor merged or
+        forgotten, is not brought back: the store would refuse it, and it would be false)."""
         changes = [
             Change.delete(p)
             for p in applied.added
             if self._store.propositions.get(p.key) == p  # still ours, unchanged
-        ] + [Change.save(p) for p in applied.deleted if self._store.propositions.get(p.key) is None]
+        ] + [
+            Change.save(p)
+            for p in applied.deleted
+            if self._store.propositions.get(p.key) is None
+            and all(self._store.objects.get(name) is not None for name in p.objects)
+        ]
         if changes:
             self._store.apply(changes)

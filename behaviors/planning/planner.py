@@ -86,9 +86,18 @@ class Planner:
         from unified_planning.engines import PlanGenerationResultStatus as Status
         from unified_planning.io import PDDLReader
 
-        problem = PDDLReader(environment=environment).parse_problem_string(
-            task.domain, task.problem
-        )
+        try:
+            problem = PDDLReader(environment=environment).parse_problem_string(
+                task.domain, task.problem
+            )
+        except Exception as error:  # noqa: BLE001 - the text comes from live data; say what broke
+            # The problem is written from the knowledge base as it is now; a fact or goal naming
+            # something a concurrent change removed is refused by the reader. That is a failed
+            # plan with its reason (the mission may plan again), never a crash of the mission.
+            return PlanningResult(
+                PlanningStatus.FAILED,
+                reason=f"the planning problem could not be read: {type(error).__name__}: {error}",
+            )
         with environment.factory.OneshotPlanner(name=self.config.engine) as engine:
             if not engine.supports(problem.kind):
                 raise ConfigurationError(

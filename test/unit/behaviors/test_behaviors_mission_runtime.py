@@ -167,6 +167,34 @@ def test_unreachable_goal_fails_with_a_clear_reason(store: KnowledgeBase, planne
     assert robot_at(store) == ["a"]
 
 
+def test_a_goal_whose_object_leaves_the_knowledge_base_mid_mission_fails_with_that_reason(
+    store: KnowledgeBase, planner: Planner
+) -> None:
+    # An anchor merged into another (or forgotten) takes its object out while a mission aims at it.
+    store.actions.save(push())
+    store.objects.save(PddlObject("book_8", "item"))
+    store.propositions.save(Proposition("object_at", ("book_8", "a"), provenance=Provenance.PERCEIVED))
+
+    def push_and_lose_it(blackboard: Blackboard) -> str:
+        store.objects.delete("book_8")
+        return ABORT
+
+    mission = Mission((Proposition("object_at", ("book_8", "b")),), name="fetch")
+    result = runner(store, planner, push_and_lose_it).run(mission)
+    assert result.status is MissionStatus.FAILED
+    assert "book_8, which the knowledge base no longer holds" in result.reason
+
+
+def test_a_problem_the_reader_refuses_is_a_failed_plan_not_a_crash(planner: Planner) -> None:
+    from merlin2_sailor_behaviors.planning import PlanningStatus
+    from merlin2_sailor_behaviors.planning.task import PlanningTask
+
+    task = PlanningTask("(define (domain d) (:requirements :strips))",
+                        "(define (problem p) (:domain d) (:goal (robot_at ghost)))", ())
+    result = planner.plan(task)
+    assert result.status is PlanningStatus.FAILED and "could not be read" in result.reason
+
+
 def test_at_end_effects_are_not_applied_when_the_action_aborts(
     store: KnowledgeBase, planner: Planner
 ) -> None:
