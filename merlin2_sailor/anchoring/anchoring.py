@@ -216,7 +216,7 @@ class Anchoring:
             symbols[row] = anchor.symbol
 
         unmatched = [int(row) for row in assignment.unmatched_percepts]
-        unresolved = unresolved_far_views(table, unmatched, [column for _, column in assignment.matches],
+        unresolved = unresolved_far_views(table, unmatched, [column for _, column in assignment.matches], partial,
                                           config.match_threshold, config.far_view)
         unmatched = [row for row in unmatched if row not in unresolved]
         percepts = self._embed_for_gallery(percepts, [row for row in unmatched if not partial[row]])

@@ -12,16 +12,17 @@ place (0.08-0.17 m) after 10-94 s away, scored 0.09-0.47. In the simulated house
 made the hall mug a second anchor, on its own spot, as the robot left the hall
 (`lookalike_added`, seed 0): a look-alike added beside it later took the first symbol.
 
-What it does. An unmatched percept is *unresolved* (no anchor acquired, its symbol empty) when an
-anchor of its class that no percept of this frame reacquired scored it at least ``score_floor``
-(not a firm "another object") and every view in that anchor's gallery is more than
-``1 / scale_ratio`` times the percept's size. The anchor is then not counted as unseen in that
-frame either (something of its class stood where it was; whether it was the anchor could not be
-told). A closer view decides: matched, it is reacquired; rejected at a comparable size, it becomes
-a new anchor. Nothing is guessed: a removed or replaced object seen only from afar is neither
-reported found nor anchored anew, it stays unknown until a view can tell. A firm rejection
-(below ``score_floor``) is acted on at any size, and a matcher without appearance (the rules,
-whose anchors have no gallery) is never affected.
+What it does. An unmatched whole view (a partial one is scored without its look anyway) is
+*unresolved* (no anchor acquired, its symbol empty) when an anchor of its class that no percept
+of this frame reacquired scored it at least ``score_floor`` (not a firm "another object") and
+every view in that anchor's gallery is more than ``1 / scale_ratio`` times the percept's size.
+The anchor is then not counted as unseen in that frame either (something of its class stood
+where it was; whether it was the anchor could not be told). A closer view decides: matched, it is
+reacquired; rejected at a comparable size, it becomes a new anchor. Nothing is guessed: a
+removed or replaced object seen only from afar is neither reported found nor anchored anew, it
+stays unknown until a view can tell. A firm rejection (below ``score_floor``) is acted on at any
+size, and a matcher without appearance (the rules, whose anchors have no gallery) is never
+affected.
 """
 
 from __future__ import annotations
@@ -55,17 +56,22 @@ class FarViewConfig:
 
 
 def unresolved_far_views(
-    table: MatchingTable, unmatched: Sequence[int], matched_columns: Sequence[int], match_threshold: float,
-    config: FarViewConfig,
+    table: MatchingTable, unmatched: Sequence[int], matched_columns: Sequence[int], partial: Sequence[bool],
+    match_threshold: float, config: FarViewConfig,
 ) -> dict[int, Anchor]:
     """{percept row: the anchor it may be} for the ``unmatched`` percepts too far to tell from an
-    anchor that no percept reacquired (``matched_columns``: the table's columns reacquired)."""
+    anchor that no percept reacquired (``matched_columns``: the table's columns reacquired).
+
+    A ``partial`` view is scored without its look already (:func:`.partial_view.comparable_views`):
+    its score says what place and time say, at any size, so it is judged as it is."""
     if config.scale_ratio <= 0.0 or not unmatched or not table.anchors:
         return {}
     taken = set(int(column) for column in matched_columns)
     smallest_views = np.array([_smallest_view(anchor) for anchor in table.anchors])
     unresolved: dict[int, Anchor] = {}
     for row in unmatched:
+        if partial[row]:
+            continue
         percept = table.percepts[row]
         size = view_scale(percept)
         if size <= 0.0:

@@ -173,3 +173,14 @@ def test_add_view_and_view_scale() -> None:
 def test_far_view_configuration_is_checked(options: dict, field: str) -> None:
     with pytest.raises(ConfigurationError, match=field):
         FarViewConfig(**options)
+
+
+def test_a_partial_far_view_is_judged_as_it_is(known_mug, maker) -> None:
+    # Cut by the image's left edge: scored without its look (the rules: 1.6 m off after a minute
+    # scores about 0.28, unsure), so its size says nothing more; a whole view there is unresolved.
+    anchoring, _ = known_mug()
+    elsewhere = SceneObject("mug", "cup", (2.5, 1.6, 0.8))
+    percept = view(maker, elsewhere, 60.0, FAR, blur=BLUR)
+    at_the_edge = dataclasses.replace(percept, box=BoundingBox2D(FAR / 2.0, 60.0, FAR, FAR))
+    result = anchoring.process([at_the_edge], camera_view(depth=flat_depth(5.0)), 60.0)
+    assert result.unresolved == () and len(result.acquired) == 1
