@@ -33,7 +33,7 @@ from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colour_evidence_grew
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
-from merlin2_sailor.anchoring.far_view import FarViewConfig, unresolved_far_views
+from merlin2_sailor.anchoring.far_view import FarViewConfig, best_rejected, unresolved_far_views
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
@@ -229,7 +229,7 @@ class Anchoring:
         unmatched.sort(key=lambda row: (class_order[percepts[row].class_name], *map(float, percepts[row].position)))
         for row in unmatched:
             anchor = acquire(self._fresh_symbol(percepts[row].class_name), percepts[row], changes, config.fusion,
-                             config.lifecycle, partial=partial[row])
+                             config.lifecycle, partial=partial[row], rejected=best_rejected(table, row))
             anchor.watched_before = self._watched.watched_without(anchor.position, anchor.class_name)
             self._index.add(anchor)
             symbols[row] = anchor.symbol

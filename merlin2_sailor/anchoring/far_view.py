@@ -96,3 +96,21 @@ def _smallest_view(anchor: Anchor) -> float:
             or np.any(np.isnan(scales)):
         return 0.0
     return float(np.min(scales))
+
+
+def best_rejected(table: MatchingTable, row: int) -> str:
+    """The anchor of the percept's class that scored it best without taking it, with the score
+    and how the view's size compares with that anchor's views: why a new anchor was made, in the
+    acquired event (a duplicate's first question). Empty when no such anchor passed the gate."""
+    percept = table.percepts[row]
+    columns = [column for column, anchor in enumerate(table.anchors)
+               if not table.gated[row, column] and anchor.class_name == percept.class_name]
+    if not columns:
+        return ""
+    column = max(columns, key=lambda candidate: table.scores[row, candidate])
+    anchor = table.anchors[column]
+    text = f"{anchor.symbol} scored {table.scores[row, column]:.2f}"
+    smallest = _smallest_view(anchor)
+    if smallest > 0.0:
+        text += f", view {view_scale(percept) / smallest:.2f} of its smallest"
+    return text

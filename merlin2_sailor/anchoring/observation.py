@@ -24,14 +24,16 @@ from merlin2_sailor.knowledge.model import Provenance
 
 def acquire(
     symbol: str, percept: Percept, changes: FrameChanges, fusion: FusionConfig, lifecycle: LifecycleConfig,
-    partial: bool = False,
+    partial: bool = False, rejected: str = "",
 ) -> Anchor:
-    """A new anchor named ``symbol`` from one percept (the caller indexes it)."""
+    """A new anchor named ``symbol`` from one percept (the caller indexes it); ``rejected``: the
+    anchor of its class it came nearest to being, and why not, for the event (empty: none)."""
     anchor = Anchor.from_percept(symbol, percept, percept.embedding, fusion, partial)
     became_confirmed = after_sighting(anchor, lifecycle)
     changes.acquired.append(anchor)
+    details = {"rejected": rejected} if rejected else {}
     changes.event(AnchorEventKind.ACQUIRED, symbol, class_name=anchor.class_name, tracker_id=percept.tracker_id,
-                  at=position_text(anchor.position))
+                  at=position_text(anchor.position), **details)
     if became_confirmed:
         changes.event(AnchorEventKind.CONFIRMED, symbol, reason="seen", times_seen=anchor.times_seen)
         changes.confirmed_newcomers.append(anchor)

@@ -184,3 +184,12 @@ def test_a_partial_far_view_is_judged_as_it_is(known_mug, maker) -> None:
     at_the_edge = dataclasses.replace(percept, box=BoundingBox2D(FAR / 2.0, 60.0, FAR, FAR))
     result = anchoring.process([at_the_edge], camera_view(depth=flat_depth(5.0)), 60.0)
     assert result.unresolved == () and len(result.acquired) == 1
+
+
+def test_a_new_anchor_says_which_anchor_it_came_nearest_to_being(known_mug, maker) -> None:
+    anchoring, mug = known_mug()
+    closer = view(maker, MUG, 60.0, CLOSE * 0.8, blur=BLUR)
+    result = anchoring.process([closer], camera_view(depth=flat_depth(5.0)), 60.0)
+    (event,) = [event for event in result.events if event.kind.value == "acquired"]
+    assert event.details["rejected"].startswith(f"{mug.symbol} scored 0.")
+    assert event.details["rejected"].endswith("view 0.80 of its smallest")
