@@ -378,7 +378,7 @@ class Anchoring:
         decisions.extend(self._repair.decide_reappearances(changes.missing, judged, self._index))
         decisions.extend(self._repair.decide_relocations(changes.missing, judged, self._index))
         decisions.extend(decide_same_space(changes.reacquired, self._index, self.config.repair.same_space_overlap,
-                                           self.config.colour))
+                                           self.config.colour, self.matcher, self.config.match_threshold))
         if changes.confirmed_newcomers:  # something new may be what a running search looks for
             for sought in self._index.expected():
                 if sought.expectation is not None and sought.expectation.is_search:

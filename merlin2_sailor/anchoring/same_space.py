@@ -11,6 +11,14 @@ smaller box, and their colours do not differ, they are one object. Measured on t
 suite of 3 December 2026: every duplicate anchor left in `crowded_shelf` (both matchers) and
 three of the five in `removed` (rules) were such pairs (overlap 0.6-1.0).
 
+No merge without evidence: with a matcher that reads appearance, the matching function must also
+take the younger anchor, its place left out (both stand on one spot by construction), for the
+older one (:func:`~.anchor_comparison.identity_scores`, as every other repair). Overlap and
+colour alone let a red book whose anchor slid onto its blue neighbour's missing one be merged
+into it (`crowded_shelf`, network, seed 0, 3 December: overlap 0.68, neither colour known from
+3-4 m, and the mission's target symbol merged away). The rules read no appearance and are judged
+as before.
+
 The older symbol stays, as in every merge, since it is the one the planner knows: a MISSING
 anchor older than the one seen takes it over (a :class:`~.identity_repair.Merge`); a younger
 MISSING one is forgotten as a :class:`Duplicate` (its few sightings were the slip's). A pair that
@@ -26,9 +34,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
 from merlin2_sailor.anchoring.identity_repair import Merge
+from merlin2_sailor.anchoring.matcher import Matcher
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -51,10 +61,12 @@ def shared_volume(first: Anchor, second: Anchor) -> float:
 
 
 def decide_same_space(
-    seen: Iterable[Anchor], index: AnchorIndex, minimum_overlap: float, colour: ColourEvidenceConfig
+    seen: Iterable[Anchor], index: AnchorIndex, minimum_overlap: float, colour: ColourEvidenceConfig,
+    matcher: Matcher | None = None, match_threshold: float = 0.5,
 ) -> list[Merge | Duplicate]:
     """Decisions for MISSING anchors that share their space with an anchor ``seen`` this frame
-    (0 ``minimum_overlap`` turns the rule off)."""
+    (0 ``minimum_overlap`` turns the rule off); ``matcher``: when it reads appearance, it must
+    take the younger of each pair for the older at ``match_threshold`` or more."""
     if minimum_overlap <= 0.0:
         return []
     current = {anchor.symbol: anchor for anchor in seen
@@ -70,7 +82,7 @@ def decide_same_space(
             if anchor.symbol in settled or other.symbol in settled or not _may_be_one(anchor, other, colour):
                 continue
             overlap = shared_volume(anchor, other)
-            if overlap < minimum_overlap:
+            if overlap < minimum_overlap or not _looks_alike(anchor, other, matcher, match_threshold):
                 continue
             settled.update((anchor.symbol, other.symbol))
             if other.first_seen < anchor.first_seen:
@@ -91,3 +103,13 @@ def _may_be_one(seen: Anchor, missing: Anchor, colour: ColourEvidenceConfig) -> 
         and seen.first_seen < missing.last_seen
         and not colours_differ(seen.colour, missing.colour, colour)
     )
+
+
+def _looks_alike(first: Anchor, second: Anchor, matcher: Matcher | None, threshold: float) -> bool:
+    """Whether an appearance matcher takes the younger anchor for the older, place left out
+    (True for a matcher without appearance: it has no evidence to add)."""
+    if matcher is None or not matcher.uses_appearance:
+        return True
+    younger, older = (first, second) if first.first_seen >= second.first_seen else (second, first)
+    score = identity_scores(matcher, [younger], older, SearchedDisc(younger.position, 0.0))[0]
+    return bool(score >= threshold)

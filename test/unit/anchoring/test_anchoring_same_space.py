@@ -17,6 +17,7 @@ from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
+from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
 from merlin2_sailor.anchoring.identity_repair import Merge, RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.same_space import Duplicate, decide_same_space, shared_volume
@@ -124,3 +125,25 @@ def test_the_rule_can_be_turned_off_and_is_checked():
                   book("book_2", 2.01, AnchorState.CONFIRMED, 0.0, 60.0), overlap=0.0) == []
     with pytest.raises(ConfigurationError, match="same_space_overlap"):
         RepairConfig(same_space_overlap=1.5)
+
+
+def test_an_appearance_matcher_must_also_take_one_for_the_other():
+    # A red book's anchor slid onto its blue neighbour's missing one, neither colour known (seen
+    # from afar): overlap and colour allow the merge; the look rules it out.
+    from .anchoring_scenes import AppearanceRules
+
+    maker = PerceptMaker(seed=5)
+    red, blue = maker.appearance("red_book"), maker.appearance("blue_book")
+    older_missing = book("book_3", 2.00, AnchorState.MISSING, 0.0, 50.0)
+    seen = book("book_8", 2.03, AnchorState.CONFIRMED, 40.0, 60.0)
+    for anchor, look in ((older_missing, blue), (seen, red)):
+        anchor.gallery = to_bfloat16_bits(look.reshape(1, -1))
+    index = AnchorIndex()
+    for anchor in (older_missing, seen):
+        index.add(anchor)
+    assert decide_same_space([seen], index, 0.5, COLOUR) != []  # the rules' judgement: one object
+    assert decide_same_space([seen], index, 0.5, COLOUR, AppearanceRules(), 0.5) == []
+
+    seen.gallery = to_bfloat16_bits(blue.reshape(1, -1))  # the same look: one object, as before
+    [merge] = decide_same_space([seen], index, 0.5, COLOUR, AppearanceRules(), 0.5)
+    assert isinstance(merge, Merge) and merge.kept is older_missing
