@@ -33,7 +33,7 @@ from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colour_evidence_grew
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
-from merlin2_sailor.anchoring.far_view import FarViewConfig, best_rejected, unresolved_far_views
+from merlin2_sailor.anchoring.far_view import FarViewConfig, nearest_anchor, unresolved_far_views
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
@@ -216,8 +216,9 @@ class Anchoring:
             symbols[row] = anchor.symbol
 
         unmatched = [int(row) for row in assignment.unmatched_percepts]
-        unresolved = unresolved_far_views(table, unmatched, [column for _, column in assignment.matches], partial,
-                                          config.match_threshold, config.far_view)
+        matched_columns = [int(column) for _, column in assignment.matches]
+        unresolved = unresolved_far_views(table, unmatched, matched_columns, partial, config.match_threshold,
+                                          config.far_view)
         unmatched = [row for row in unmatched if row not in unresolved]
         percepts = self._embed_for_gallery(percepts, [row for row in unmatched if not partial[row]])
         # New anchors of one class in one frame take their symbols in the order of their places, not
@@ -228,8 +229,9 @@ class Anchoring:
             class_order.setdefault(percepts[row].class_name, len(class_order))
         unmatched.sort(key=lambda row: (class_order[percepts[row].class_name], *map(float, percepts[row].position)))
         for row in unmatched:
+            nearest = nearest_anchor(table, row, matched_columns)
             anchor = acquire(self._fresh_symbol(percepts[row].class_name), percepts[row], changes, config.fusion,
-                             config.lifecycle, partial=partial[row], rejected=best_rejected(table, row))
+                             config.lifecycle, partial=partial[row], nearest=nearest)
             anchor.watched_before = self._watched.watched_without(anchor.position, anchor.class_name)
             self._index.add(anchor)
             symbols[row] = anchor.symbol

@@ -98,10 +98,11 @@ def _smallest_view(anchor: Anchor) -> float:
     return float(np.min(scales))
 
 
-def best_rejected(table: MatchingTable, row: int) -> str:
-    """The anchor of the percept's class that scored it best without taking it, with the score
-    and how the view's size compares with that anchor's views: why a new anchor was made, in the
-    acquired event (a duplicate's first question). Empty when no such anchor passed the gate."""
+def nearest_anchor(table: MatchingTable, row: int, matched_columns: Sequence[int]) -> str:
+    """The anchor of the percept's class that scored it best, with the score, how the view's size
+    compares with that anchor's views, and whether another view of the frame took it: why a new
+    anchor was made, for the acquired event (a duplicate's first question). Empty when no anchor
+    of its class passed the gate."""
     percept = table.percepts[row]
     columns = [column for column, anchor in enumerate(table.anchors)
                if not table.gated[row, column] and anchor.class_name == percept.class_name]
@@ -113,4 +114,6 @@ def best_rejected(table: MatchingTable, row: int) -> str:
     smallest = _smallest_view(anchor)
     if smallest > 0.0:
         text += f", view {view_scale(percept) / smallest:.2f} of its smallest"
+    if column in set(int(taken) for taken in matched_columns):
+        text += ", taken by another view"
     return text

@@ -24,14 +24,14 @@ from merlin2_sailor.knowledge.model import Provenance
 
 def acquire(
     symbol: str, percept: Percept, changes: FrameChanges, fusion: FusionConfig, lifecycle: LifecycleConfig,
-    partial: bool = False, rejected: str = "",
+    partial: bool = False, nearest: str = "",
 ) -> Anchor:
-    """A new anchor named ``symbol`` from one percept (the caller indexes it); ``rejected``: the
+    """A new anchor named ``symbol`` from one percept (the caller indexes it); ``nearest``: the
     anchor of its class it came nearest to being, and why not, for the event (empty: none)."""
     anchor = Anchor.from_percept(symbol, percept, percept.embedding, fusion, partial)
     became_confirmed = after_sighting(anchor, lifecycle)
     changes.acquired.append(anchor)
-    details = {"rejected": rejected} if rejected else {}
+    details = {"nearest_anchor": nearest} if nearest else {}
     changes.event(AnchorEventKind.ACQUIRED, symbol, class_name=anchor.class_name, tracker_id=percept.tracker_id,
                   at=position_text(anchor.position), **details)
     if became_confirmed:

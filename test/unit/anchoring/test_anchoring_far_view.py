@@ -191,5 +191,12 @@ def test_a_new_anchor_says_which_anchor_it_came_nearest_to_being(known_mug, make
     closer = view(maker, MUG, 60.0, CLOSE * 0.8, blur=BLUR)
     result = anchoring.process([closer], camera_view(depth=flat_depth(5.0)), 60.0)
     (event,) = [event for event in result.events if event.kind.value == "acquired"]
-    assert event.details["rejected"].startswith(f"{mug.symbol} scored 0.")
-    assert event.details["rejected"].endswith("view 0.80 of its smallest")
+    assert event.details["nearest_anchor"].startswith(f"{mug.symbol} scored 0.")
+    assert event.details["nearest_anchor"].endswith("view 0.80 of its smallest")
+
+    # Two views, one anchor: the one not assigned says the anchor went to the other view.
+    anchoring, mug = known_mug()
+    result = anchoring.process([view(maker, MUG, 60.0, CLOSE), view(maker, MUG, 60.0, CLOSE * 0.9)],
+                               camera_view(depth=flat_depth(5.0)), 60.0)
+    (event,) = [event for event in result.events if event.kind.value == "acquired"]
+    assert event.details["nearest_anchor"].endswith("taken by another view")
