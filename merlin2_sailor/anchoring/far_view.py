@@ -107,7 +107,9 @@ def nearest_anchor(table: MatchingTable, row: int, matched_columns: Sequence[int
     columns = [column for column, anchor in enumerate(table.anchors)
                if not table.gated[row, column] and anchor.class_name == percept.class_name]
     if not columns:
-        return ""
+        # Gated by colour: the view's colour ruled out an anchor whose own went unchecked a while.
+        disputed = sorted(anchor.symbol for anchor in table.disputed if anchor.class_name == percept.class_name)
+        return f"{', '.join(disputed)} ruled out by colour" if disputed else ""
     column = max(columns, key=lambda candidate: table.scores[row, candidate])
     anchor = table.anchors[column]
     text = f"{anchor.symbol} scored {table.scores[row, column]:.2f}"

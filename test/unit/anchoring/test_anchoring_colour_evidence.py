@@ -277,3 +277,13 @@ def test_views_without_colour_do_not_bring_back_an_anchor_a_view_of_another_colo
     # The red mug put back: a view of its own colour settles the dispute.
     assert see(anchoring, maker, [red], 120.0, frames=6).percept_symbols == ("cup_1",)
     assert not anchoring.get("cup_1").colour_disputed
+
+
+def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
+    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
+    anchoring, maker = rules(), PerceptMaker(seed=6)
+    see(anchoring, maker, [red], 0.0)
+    result = see(anchoring, maker, [green], 61.0, frames=1)
+    (acquired,) = [event for event in result.events if event.kind is AnchorEventKind.ACQUIRED]
+    assert acquired.details["nearest_anchor"] == "cup_1 ruled out by colour"
