@@ -20,7 +20,7 @@ import numpy as np
 from merlin2_sailor.anchoring.colour_evidence import ColourModel, combined, with_view
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
-from merlin2_sailor.anchoring.gallery import add_view, from_bfloat16_bits
+from merlin2_sailor.anchoring.gallery import add_view, from_bfloat16_bits, view_scales
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
 
@@ -200,9 +200,7 @@ class Anchor:
             self.class_votes[class_name] = self.class_votes.get(class_name, 0.0) + votes
         self.class_name = winning_class(self.class_votes, self.class_name)
         if other.gallery is not None:
-            scales = other.gallery_scales
-            if scales is None or len(scales) != len(other.gallery):
-                scales = np.full(len(other.gallery), np.nan)
+            scales = view_scales(other.gallery, other.gallery_scales)
             for view, scale in zip(from_bfloat16_bits(other.gallery), scales, strict=True):
                 self.gallery, self.gallery_scales = add_view(self.gallery, self.gallery_scales, view, float(scale),
                                                              config.gallery_size)

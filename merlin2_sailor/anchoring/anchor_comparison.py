@@ -70,6 +70,12 @@ def identity_scores(
     return np.bincount(owners, weights=per_view, minlength=len(candidates)) / views
 
 
+def score_anywhere(matcher: Matcher, candidate: Anchor, lost: Anchor) -> float:
+    """M(candidate, lost) with place left out (measured from a disc of radius 0 at the candidate):
+    whether it is the lost object by everything but where it stands."""
+    return float(identity_scores(matcher, [candidate], lost, SearchedDisc(candidate.position, 0.0))[0])
+
+
 def _candidates_as_percepts(
     candidates: Sequence[Anchor], with_views: np.ndarray
 ) -> tuple[PerceptColumns, np.ndarray]:

@@ -216,9 +216,9 @@ class Anchoring:
             symbols[row] = anchor.symbol
 
         unmatched = [int(row) for row in assignment.unmatched_percepts]
-        matched_columns = [int(column) for _, column in assignment.matches]
-        unresolved = unresolved_far_views(table, unmatched, matched_columns, partial, config.match_threshold,
-                                          config.far_view)
+        taken = np.zeros(len(table.anchors), dtype=bool)
+        taken[[int(column) for _, column in assignment.matches]] = True
+        unresolved = unresolved_far_views(table, unmatched, taken, partial, config.match_threshold, config.far_view)
         unmatched = [row for row in unmatched if row not in unresolved]
         percepts = self._embed_for_gallery(percepts, [row for row in unmatched if not partial[row]])
         # New anchors of one class in one frame take their symbols in the order of their places, not
@@ -229,7 +229,7 @@ class Anchoring:
             class_order.setdefault(percepts[row].class_name, len(class_order))
         unmatched.sort(key=lambda row: (class_order[percepts[row].class_name], *map(float, percepts[row].position)))
         for row in unmatched:
-            nearest = nearest_anchor(table, row, matched_columns)
+            nearest = nearest_anchor(table, row, taken)
             anchor = acquire(self._fresh_symbol(percepts[row].class_name), percepts[row], changes, config.fusion,
                              config.lifecycle, partial=partial[row], nearest=nearest)
             anchor.watched_before = self._watched.watched_without(anchor.position, anchor.class_name)

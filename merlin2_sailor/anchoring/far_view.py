@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, view_scale
+from merlin2_sailor.anchoring.gallery import view_scales
 from merlin2_sailor.anchoring.matching_table import MatchingTable
 from merlin2_sailor.errors import ConfigurationError
 
@@ -56,53 +57,43 @@ class FarViewConfig:
 
 
 def unresolved_far_views(
-    table: MatchingTable, unmatched: Sequence[int], matched_columns: Sequence[int], partial: Sequence[bool],
+    table: MatchingTable, unmatched: Sequence[int], taken: np.ndarray, partial: Sequence[bool],
     match_threshold: float, config: FarViewConfig,
 ) -> dict[int, Anchor]:
     """{percept row: the anchor it may be} for the ``unmatched`` percepts too far to tell from an
-    anchor that no percept reacquired (``matched_columns``: the table's columns reacquired).
+    anchor that no percept reacquired (``taken``: (A,) bool, the table's columns reacquired).
 
     A ``partial`` view is scored without its look already (:func:`.partial_view.comparable_views`):
     its score says what place and time say, at any size, so it is judged as it is."""
-    if config.scale_ratio <= 0.0 or not unmatched or not table.anchors:
+    rows = [row for row in unmatched if not partial[row]]
+    if config.scale_ratio <= 0.0 or not rows or not table.anchors:
         return {}
-    taken = set(int(column) for column in matched_columns)
-    smallest_views = np.array([_smallest_view(anchor) for anchor in table.anchors])
+    classes = np.array([anchor.class_name for anchor in table.anchors], dtype=object)
+    smallest = np.array([smallest_view(anchor) for anchor in table.anchors])
     unresolved: dict[int, Anchor] = {}
-    for row in unmatched:
-        if partial[row]:
-            continue
+    for row in rows:
         percept = table.percepts[row]
-        size = view_scale(percept)
-        if size <= 0.0:
-            continue
         scores = table.scores[row]
-        candidates = [
-            column for column, anchor in enumerate(table.anchors)
-            if column not in taken and not table.gated[row, column] and anchor.class_name == percept.class_name
-            and config.score_floor <= scores[column] < match_threshold
-            and size < config.scale_ratio * smallest_views[column]
-        ]
-        if candidates:
-            unresolved[int(row)] = table.anchors[max(candidates, key=lambda column: scores[column])]
+        candidates = (~taken & ~table.gated[row] & (classes == percept.class_name)
+                      & (scores >= config.score_floor) & (scores < match_threshold)
+                      & (0.0 < view_scale(percept)) & (view_scale(percept) < config.scale_ratio * smallest))
+        if candidates.any():
+            unresolved[int(row)] = table.anchors[int(np.argmax(np.where(candidates, scores, -np.inf)))]
     return unresolved
 
 
-def _smallest_view(anchor: Anchor) -> float:
+def smallest_view(anchor: Anchor) -> float:
     """The size of the smallest view in the anchor's gallery; 0 when any is unknown or there is
     none (nothing then says the percept is far from all of them)."""
-    scales = anchor.gallery_scales
-    if anchor.gallery is None or scales is None or len(scales) == 0 or len(scales) != len(anchor.gallery) \
-            or np.any(np.isnan(scales)):
-        return 0.0
-    return float(np.min(scales))
+    scales = view_scales(anchor.gallery, anchor.gallery_scales)
+    return 0.0 if len(scales) == 0 or np.isnan(scales).any() else float(scales.min())
 
 
-def nearest_anchor(table: MatchingTable, row: int, matched_columns: Sequence[int]) -> str:
+def nearest_anchor(table: MatchingTable, row: int, taken: np.ndarray) -> str:
     """The anchor of the percept's class that scored it best, with the score, how the view's size
-    compares with that anchor's views, and whether another view of the frame took it: why a new
-    anchor was made, for the acquired event (a duplicate's first question). Empty when no anchor
-    of its class passed the gate."""
+    compares with that anchor's views, and whether another view of the frame took it (``taken``:
+    (A,) bool, the columns reacquired): why a new anchor was made, for the acquired event (a
+    duplicate's first question). Empty when no anchor of its class passed the gate."""
     percept = table.percepts[row]
     columns = [column for column, anchor in enumerate(table.anchors)
                if not table.gated[row, column] and anchor.class_name == percept.class_name]
@@ -113,9 +104,9 @@ def nearest_anchor(table: MatchingTable, row: int, matched_columns: Sequence[int
     column = max(columns, key=lambda candidate: table.scores[row, candidate])
     anchor = table.anchors[column]
     text = f"{anchor.symbol} scored {table.scores[row, column]:.2f}"
-    smallest = _smallest_view(anchor)
+    smallest = smallest_view(anchor)
     if smallest > 0.0:
         text += f", view {view_scale(percept) / smallest:.2f} of its smallest"
-    if column in set(int(taken) for taken in matched_columns):
+    if taken[column]:
         text += ", taken by another view"
     return text

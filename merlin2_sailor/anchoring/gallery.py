@@ -50,11 +50,18 @@ def add_view(
     (``scale``: the square root of its area; NaN where unknown, as for a gallery restored from a
     snapshot that did not keep sizes). A view much smaller than every view in a gallery is weak
     evidence against it (:mod:`.far_view`), so the sizes go where the views go."""
-    kept = 0 if gallery is None else len(gallery)
-    old = scales if scales is not None and len(scales) == kept else np.full(kept, np.nan)
     new_gallery = add_to_gallery(gallery, embedding, size)
-    new_scales = np.append(np.asarray(old, dtype=np.float32), np.float32(scale))[-len(new_gallery):]
+    new_scales = np.append(view_scales(gallery, scales), np.float32(scale))[-len(new_gallery):]
     return new_gallery, new_scales
+
+
+def view_scales(gallery: np.ndarray | None, scales: np.ndarray | None) -> np.ndarray:
+    """(n,) float32 sizes of a gallery's n views: ``scales``, or NaN (unknown) where they do not
+    describe the gallery (none kept, or another length)."""
+    count = 0 if gallery is None else len(gallery)
+    if scales is not None and len(scales) == count:
+        return np.asarray(scales, dtype=np.float32)
+    return np.full(count, np.nan, dtype=np.float32)
 
 
 def gallery_similarity(first: np.ndarray, second: np.ndarray) -> float:

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_agree, colours_differ
 from merlin2_sailor.anchoring.expectation import Expectation
@@ -226,7 +226,7 @@ class IdentityRepair:
     def _decide_relocation(self, lost: Anchor, candidates: Sequence[Anchor], index: AnchorIndex) -> Merge | None:
         if not candidates:
             return None
-        scores = np.array([self._score_anywhere(candidate, lost) for candidate in candidates])
+        scores = np.array([score_anywhere(self.matcher, candidate, lost) for candidate in candidates])
         best = int(np.argmax(scores))
         if scores[best] < self.match_threshold:
             return None
@@ -236,13 +236,9 @@ class IdentityRepair:
         for rival in index.of_class(chosen.class_name):
             if (rival is not lost and rival.state is AnchorState.MISSING and rival.expectation is None
                     and self._relocation_possible(chosen, rival)
-                    and self._score_anywhere(chosen, rival) > scores[best] - self.config.ambiguity_margin):
+                    and score_anywhere(self.matcher, chosen, rival) > scores[best] - self.config.ambiguity_margin):
                 return None
         return Merge(lost, chosen, float(scores[best]), "moved: it appeared where the camera had watched", True)
-
-    def _score_anywhere(self, candidate: Anchor, lost: Anchor) -> float:
-        """The matching function's score with place left out (the lost anchor could be anywhere)."""
-        return float(identity_scores(self.matcher, [candidate], lost, SearchedDisc(candidate.position, 0.0))[0])
 
     def _arrived(self, anchor: Anchor) -> bool:
         return anchor.watched_before >= self.arrival_frames

@@ -13,7 +13,7 @@ three of the five in `removed` (rules) were such pairs (overlap 0.6-1.0).
 
 No merge without evidence: with a matcher that reads appearance, the matching function must also
 take the younger anchor, its place left out (both stand on one spot by construction), for the
-older one (:func:`~.anchor_comparison.identity_scores`, as every other repair). Overlap and
+older one (:func:`~.anchor_comparison.score_anywhere`, as the other repairs ask). Overlap and
 colour alone let a red book whose anchor slid onto its blue neighbour's missing one be merged
 into it (`crowded_shelf`, network, seed 0, 3 December: overlap 0.68, neither colour known from
 3-4 m, and the mission's target symbol merged away). The rules read no appearance and are judged
@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
+from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
 from merlin2_sailor.anchoring.identity_repair import Merge
@@ -111,5 +111,4 @@ def _looks_alike(first: Anchor, second: Anchor, matcher: Matcher | None, thresho
     if matcher is None or not matcher.uses_appearance:
         return True
     younger, older = (first, second) if first.first_seen >= second.first_seen else (second, first)
-    score = identity_scores(matcher, [younger], older, SearchedDisc(younger.position, 0.0))[0]
-    return bool(score >= threshold)
+    return score_anywhere(matcher, younger, older) >= threshold

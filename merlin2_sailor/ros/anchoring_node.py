@@ -19,6 +19,7 @@ for occlusion), ``robot_pose`` (for carried objects); out ``anchors`` (latched, 
 from __future__ import annotations
 
 import threading
+from collections import Counter
 from collections.abc import Sequence
 from typing import Any
 
@@ -126,7 +127,7 @@ class AnchoringNode(Node):
         self._anchoring_thread.start()
         self._reported_drops = 0
         self._reported_embedding = (0, 0)
-        self._unresolved: dict[str, int] = {}  # anchor -> views too far to tell from it, this period
+        self._unresolved: Counter[str] = Counter()  # anchor -> views too far to tell from it, this period
         self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report)
 
         self.service.start()
@@ -202,7 +203,7 @@ class AnchoringNode(Node):
         """Views left unresolved in the last period (too far to tell from an anchor: far_view)."""
         if not self._unresolved:
             return
-        counts, self._unresolved = self._unresolved, {}
+        counts, self._unresolved = self._unresolved, Counter()
         anchors = ", ".join(f"{symbol} ({views})" for symbol, views in sorted(counts.items()))
         self.get_logger().info(f"views in the last {DROP_REPORT_PERIOD_SECONDS:g} s too far to tell whether they "
                                f"show {anchors}: left unresolved until a closer view")
@@ -237,8 +238,7 @@ class AnchoringNode(Node):
             self.get_logger().warning(f"dropped {len(message.percepts)} percepts: {error}",
                                       throttle_duration_sec=5.0)
             return
-        for symbol in result.unresolved:
-            self._unresolved[symbol] = self._unresolved.get(symbol, 0) + 1
+        self._unresolved.update(result.unresolved)
         self._publish(result)
 
     def _refuse_future_stamps(self, stamp: float, message: PerceptArray) -> None:
