@@ -35,6 +35,7 @@ from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.far_view import FarViewConfig, nearest_anchor, unresolved_far_views
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
+from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, register_frame, shift_percepts
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
@@ -76,7 +77,8 @@ class AnchoringConfig:
     (:mod:`.colour_evidence`), in the matching table and in every merge; ``watch``: where the
     camera has watched, so that an object first seen there arrived (:mod:`.watched_places`);
     ``far_view``: when a view too small to compare with an anchor's is left unresolved
-    (:mod:`.far_view`).
+    (:mod:`.far_view`); ``registration``: when a frame's percepts share a pose error to take out
+    before matching (:mod:`.frame_registration`).
     """
 
     match_threshold: float = 0.5
@@ -91,6 +93,7 @@ class AnchoringConfig:
     visibility: VisibilityConfig = field(default_factory=VisibilityConfig)
     watch: WatchConfig = field(default_factory=WatchConfig)
     far_view: FarViewConfig = field(default_factory=FarViewConfig)
+    registration: RegistrationConfig = field(default_factory=RegistrationConfig)
     index: IndexConfig = field(default_factory=IndexConfig)
 
     def __post_init__(self) -> None:
@@ -197,6 +200,9 @@ class Anchoring:
         partial = partial_views(percepts, camera, self.config.partial_view)
         # Without a camera nothing says which views are whole, so no single view is colour evidence.
         whole = None if camera is None else [not flag for flag in partial]
+        # The pose error all of this frame's percepts share is taken out before anything is judged.
+        frame_offset = register_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
+        percepts = shift_percepts(percepts, frame_offset)
         table = self._table_builder.build(percepts, self._index, whole)
         for anchor in table.disputed:
             anchor.colour_disputed = True
@@ -249,7 +255,7 @@ class Anchoring:
             if anchor.symbol not in seen:
                 anchor.visible = False
         may_be = tuple(renamed.get(anchor.symbol, anchor.symbol) for anchor in unresolved.values())
-        return changes.result(symbols, may_be)
+        return changes.result(symbols, may_be, frame_offset)
 
     def track(self, stamp: float, robot_pose: Pose | None = None) -> AnchoringResult:
         """Extend anchors without observation and apply the lifecycle's time-outs.

@@ -8,13 +8,15 @@ from typing import Any
 
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
+from merlin2_sailor.anchoring.frame_registration import FrameOffset
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class AnchoringResult:
     """What one call changed. ``percept_symbols[i]`` is the symbol percept i was anchored to, or ""
     for a percept left unresolved (:mod:`.far_view`); ``unresolved`` names, per such percept, the
-    anchor it may have been."""
+    anchor it may have been; ``frame_offset``: the shared pose error taken out of the frame's
+    percepts before matching (:mod:`.frame_registration`), None when none was."""
 
     stamp: float
     acquired: tuple[Anchor, ...] = ()
@@ -24,6 +26,7 @@ class AnchoringResult:
     events: tuple[AnchorEvent, ...] = ()
     percept_symbols: tuple[str, ...] = ()
     unresolved: tuple[str, ...] = ()
+    frame_offset: FrameOffset | None = None
 
 
 @dataclass(slots=True)
@@ -43,7 +46,10 @@ class FrameChanges:
     def event(self, kind: AnchorEventKind, symbol: str, **details: Any) -> None:
         self.events.append(AnchorEvent(kind, symbol, self.stamp, details))
 
-    def result(self, percept_symbols: Sequence[str] = (), unresolved: Sequence[str] = ()) -> AnchoringResult:
+    def result(
+        self, percept_symbols: Sequence[str] = (), unresolved: Sequence[str] = (),
+        frame_offset: FrameOffset | None = None,
+    ) -> AnchoringResult:
         return AnchoringResult(
             self.stamp,
             tuple(self.acquired),
@@ -53,4 +59,5 @@ class FrameChanges:
             tuple(self.events),
             tuple(percept_symbols),
             tuple(unresolved),
+            frame_offset,
         )

@@ -388,6 +388,21 @@ SETTINGS: tuple[Setting, ...] = (
                 0.0, 0.99),
     ),
     *_group(
+        "Frame registration (the pose error a frame's percepts share)",
+        Setting("registration_maximum_offset", ("core", "registration", "maximum_offset"),
+                "The largest pose error (m) looked for: before matching, the one horizontal offset that puts "
+                "the most of a frame's whole views on settled anchors of their class is added to every "
+                "percept of the frame (0 turns it off).", 0.0, 5.0),
+        Setting("registration_inlier_radius", ("core", "registration", "inlier_radius"),
+                "How close (m, horizontally) a shifted percept must come to an anchor of its class to "
+                "count for an offset.", 0.0, 1.0),
+        Setting("registration_minimum_support", ("core", "registration", "minimum_support"),
+                "How many percepts an offset must put on anchors to be applied (it must also put more "
+                "there than no offset does, and more than twice as many as any rival offset).", 2, 1000),
+        Setting("registration_minimum_views", ("core", "registration", "minimum_views"),
+                "How many times an anchor must have been seen to serve as a landmark for the offset.", 1, 1000000),
+    ),
+    *_group(
         "Spatial index (performance only)",
         Setting("index_tolerance", ("core", "index", "tolerance"),
                 "How far (m) an anchor may drift before it is re-indexed.", 0.0, 100.0),

@@ -128,6 +128,7 @@ class AnchoringNode(Node):
         self._reported_drops = 0
         self._reported_embedding = (0, 0)
         self._unresolved: Counter[str] = Counter()  # anchor -> views too far to tell from it, this period
+        self._offsets: list[float] = []  # pose errors (m) taken out of frames this period
         self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report)
 
         self.service.start()
@@ -198,6 +199,7 @@ class AnchoringNode(Node):
         self._report_drops()
         self._report_embedding()
         self._report_unresolved()
+        self._report_offsets()
 
     def _report_unresolved(self) -> None:
         """Views left unresolved in the last period (too far to tell from an anchor: far_view)."""
@@ -207,6 +209,16 @@ class AnchoringNode(Node):
         anchors = ", ".join(f"{symbol} ({views})" for symbol, views in sorted(counts.items()))
         self.get_logger().info(f"views in the last {DROP_REPORT_PERIOD_SECONDS:g} s too far to tell whether they "
                                f"show {anchors}: left unresolved until a closer view")
+
+    def _report_offsets(self) -> None:
+        """Frames whose shared pose error was taken out in the last period (frame_registration):
+        many, or large ones, say the robot's localisation drifts."""
+        if not self._offsets:
+            return
+        offsets, self._offsets = self._offsets, []
+        self.get_logger().info(
+            f"{len(offsets)} frame(s) in the last {DROP_REPORT_PERIOD_SECONDS:g} s were seen off their anchors by "
+            f"one shared pose error (up to {max(offsets):.2f} m), taken out before matching")
 
     def _report_embedding(self) -> None:
         """How many crops the last period embedded, and how many took a recent crop's embedding."""
@@ -239,6 +251,8 @@ class AnchoringNode(Node):
                                       throttle_duration_sec=5.0)
             return
         self._unresolved.update(result.unresolved)
+        if result.frame_offset is not None:
+            self._offsets.append(result.frame_offset.distance)
         self._publish(result)
 
     def _refuse_future_stamps(self, stamp: float, message: PerceptArray) -> None:

@@ -1,0 +1,192 @@
+"""Registering a frame's percepts on the anchors: one offset for the pose error they all share.
+
+Why. A percept's world position is its camera-frame position carried through the robot's pose
+estimate, so every percept of one frame carries the same pose error. Matching judges each
+percept-anchor pair on its own, as if positions had independent errors; a shared error is then
+read as every object having moved the same way. Measured in `crowded_shelf` (rules, seed 0,
+3 December 2026): coming back through the doorway, the heading estimate was 1.1 degrees off and
+every book on the shelf, 4 m away, was seen 0.07-0.09 m to the left of its anchor (books stand
+0.18 m apart). Each percept still went to its own anchor, but fusion pulled the anchors 0.1 m
+along in three frames; when the localiser corrected the pose the next frame, the percepts were
+back in place, nearer the left neighbour's drifted anchor than their own, the tracker's ids had
+slid one book along with the image, and two anchors took their neighbours' books for good (a new
+anchor for the one left over, and the target's anchor merged away as "a second anchor in the same
+space"). Every identity rule downstream then worked from anchors that had moved with the pose.
+
+What it does. Before matching, it looks for the one horizontal offset that, added to every
+percept, puts the most of them on an anchor of their class (within ``inlier_radius``) whose
+colour the view does not contradict: the candidate offsets are the displacements from each
+percept to each confirmed, settled anchor of its class within ``maximum_offset``, and each
+candidate is scored by the number of percepts it explains, counting each anchor once. This is
+the joint-compatibility idea of SLAM data association (Neira and Tardos, 2001), reduced to its
+dominant term: pairings are judged together, under one pose error, rather than each on its own.
+
+Nothing is guessed. The best offset is applied only when it explains at least
+``minimum_support`` percepts, more than no offset does, and more than twice as many as any
+rival offset (one farther than twice the inlier radius from it, no offset included): a frame
+whose objects sit on their anchors, or where one object moved, is left as it is, and so is a
+frame that could be read two ways. That happens on a row of look-alikes when the pose error is
+half their spacing (every percept midway between two anchors: in the same run, half a book to
+the left or to the right explained six books each); colours tell such readings apart when the
+row's objects differ in colour and the views are close enough to measure it. The chosen offset
+is refined to the mean displacement of the percepts it explains.
+
+What it cannot do. Only whole views count as evidence (a cut view's centre is not its object's);
+the offset is then applied to every percept of the frame. Heading errors displace far objects
+more than near ones; a translation is their first-order correction within the inlier radius.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, view_differs
+from merlin2_sailor.anchoring.expectation import ExpectationKind
+from merlin2_sailor.contract.percept import Percept
+from merlin2_sailor.errors import ConfigurationError
+
+
+@dataclass(frozen=True, slots=True)
+class RegistrationConfig:
+    """``maximum_offset`` (m): the largest pose error looked for (0 turns registration off);
+    ``inlier_radius`` (m): how close, horizontally, a shifted percept must come to an anchor of
+    its class to be explained; ``minimum_support``: how many percepts an offset must explain;
+    ``minimum_views``: how many times an anchor must have been seen to serve as a landmark."""
+
+    maximum_offset: float = 0.3
+    inlier_radius: float = 0.04
+    minimum_support: int = 3
+    minimum_views: int = 5
+
+    def __post_init__(self) -> None:
+        for name in ("maximum_offset", "inlier_radius"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ConfigurationError(f"registration {name} must be a non-negative number of metres, got {value}.")
+        if self.maximum_offset > 0.0 and self.inlier_radius <= 0.0:
+            raise ConfigurationError("registration inlier_radius must be positive while registration is on.")
+        if self.minimum_support < 2:
+            raise ConfigurationError(
+                f"registration minimum_support must be at least 2 (one percept is not a shared error), "
+                f"got {self.minimum_support}.")
+        if self.minimum_views < 1:
+            raise ConfigurationError(f"registration minimum_views must be at least 1, got {self.minimum_views}.")
+
+
+@dataclass(frozen=True, slots=True)
+class FrameOffset:
+    """The offset (m, world frame, (3,) with z 0) added to every percept of a frame; ``support``:
+    the percepts it put on an anchor, against ``support_without`` with no offset."""
+
+    offset: np.ndarray
+    support: int
+    support_without: int
+
+    @property
+    def distance(self) -> float:
+        return float(np.linalg.norm(self.offset))
+
+
+def register_frame(
+    percepts: Sequence[Percept], index: AnchorIndex, config: RegistrationConfig, whole: Sequence[bool] | None = None,
+    colour: ColourEvidenceConfig | None = None,
+) -> FrameOffset | None:
+    """The offset that puts the frame's percepts on the anchors, or None when none is justified.
+
+    ``whole``: per percept, whether it shows its whole object (None: all count); ``colour``: when a
+    view's colour rules an anchor out (None: the defaults)."""
+    if config.maximum_offset <= 0.0 or len(percepts) < config.minimum_support or len(index) == 0:
+        return None
+    rows = [row for row in range(len(percepts)) if whole is None or whole[row]]
+    if len(rows) < config.minimum_support:
+        return None
+    positions = np.array([percepts[row].position for row in rows], dtype=np.float64)
+    pair_rows, pair_columns, displacements = _candidate_pairs(
+        [percepts[row] for row in rows], positions, index, config, colour or ColourEvidenceConfig())
+    if len(set(pair_rows.tolist())) < config.minimum_support:
+        return None
+    # (candidate offset, pair): does the pair agree with the offset? Offset 0 is candidate 0.
+    candidates = np.vstack((np.zeros((1, 2)), displacements))
+    agrees = np.linalg.norm(displacements[np.newaxis, :, :] - candidates[:, np.newaxis, :], axis=2) \
+        <= config.inlier_radius
+    support = np.array([_explained(pair_rows[row], pair_columns[row]) for row in agrees])
+    best = _best_candidate(support, candidates)
+    rivals = np.linalg.norm(candidates - candidates[best], axis=1) > 2.0 * config.inlier_radius
+    rival_support = int(support[rivals].max()) if rivals.any() else 0
+    if support[best] < config.minimum_support or support[best] <= support[0] or support[best] <= 2 * rival_support:
+        return None
+    chosen = _one_pair_per_percept(agrees[best], pair_rows, displacements, candidates[best])
+    offset = displacements[chosen].mean(axis=0)
+    return FrameOffset(np.array([offset[0], offset[1], 0.0]), int(support[best]), int(support[0]))
+
+
+def shift_percepts(percepts: Sequence[Percept], frame_offset: FrameOffset | None) -> tuple[Percept, ...]:
+    """The percepts with ``frame_offset`` added to their positions (as they are for None)."""
+    if frame_offset is None:
+        return tuple(percepts)
+    return tuple(dataclasses.replace(percept, position=np.asarray(percept.position, dtype=np.float64)
+                                     + frame_offset.offset) for percept in percepts)
+
+
+def _is_landmark(anchor: Anchor, minimum_views: int) -> bool:
+    """A settled anchor whose place the robot believes: confirmed, seen often, not carried or sought."""
+    expectation = anchor.expectation
+    return (anchor.state is AnchorState.CONFIRMED and anchor.times_seen >= minimum_views
+            and (expectation is None or (expectation.kind is ExpectationKind.AT and not expectation.is_search)))
+
+
+def _candidate_pairs(
+    percepts: Sequence[Percept], positions: np.ndarray, index: AnchorIndex, config: RegistrationConfig,
+    colour: ColourEvidenceConfig,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(percept row, anchor slot, horizontal displacement anchor - percept) for every percept and
+    landmark of its class within ``maximum_offset`` horizontally whose colour the view does not
+    contradict."""
+    rows: list[int] = []
+    slots: list[int] = []
+    displacements: list[np.ndarray] = []
+    # The index searches in 3D; a horizontal offset of maximum_offset is at most that far in 3D
+    # once the height differs by little, and a pair with a larger height difference is not one.
+    for row, found in enumerate(index.within(positions, config.maximum_offset)):
+        for slot, anchor in zip(found.tolist(), index.anchors_at(found), strict=True):
+            percept = percepts[row]
+            if (anchor.class_name != percept.class_name or not _is_landmark(anchor, config.minimum_views)
+                    or view_differs(anchor.colour, percept.colour, colour)):
+                continue
+            rows.append(row)
+            slots.append(slot)
+            displacements.append(np.asarray(anchor.position[:2], dtype=np.float64) - positions[row, :2])
+    if not rows:
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp), np.zeros((0, 2))
+    return np.array(rows, dtype=np.intp), np.array(slots, dtype=np.intp), np.array(displacements)
+
+
+def _explained(rows: np.ndarray, slots: np.ndarray) -> int:
+    """How many percepts the agreeing pairs explain, each anchor explaining one percept at most."""
+    return min(len(np.unique(rows)), len(np.unique(slots)))
+
+
+def _best_candidate(support: np.ndarray, candidates: np.ndarray) -> int:
+    """The candidate explaining the most percepts; of equals, the smallest offset."""
+    ranking = np.lexsort((np.linalg.norm(candidates, axis=1), -support))
+    return int(ranking[0])
+
+
+def _one_pair_per_percept(
+    agrees: np.ndarray, pair_rows: np.ndarray, displacements: np.ndarray, offset: np.ndarray,
+) -> np.ndarray:
+    """Among the pairs that agree with ``offset``, the one per percept closest to it."""
+    chosen: dict[int, int] = {}
+    for pair in np.flatnonzero(agrees).tolist():
+        row = int(pair_rows[pair])
+        error = float(np.linalg.norm(displacements[pair] - offset))
+        if row not in chosen or error < float(np.linalg.norm(displacements[chosen[row]] - offset)):
+            chosen[row] = pair
+    return np.array(sorted(chosen.values()), dtype=np.intp)
