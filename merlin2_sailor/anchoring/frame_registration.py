@@ -26,8 +26,8 @@ Nothing is guessed. The best offset is applied only when it explains at least
 rival offset (one farther than twice the inlier radius from it, no offset included): a frame
 whose objects sit on their anchors, or where one object moved, is left as it is, and so is a
 frame that could be read two ways. That happens on a row of look-alikes when the pose error is
-half their spacing (every percept midway between two anchors: in the same run, half a book to
-the left or to the right explained six books each); colours tell such readings apart when the
+half their spacing (every percept midway between two anchors: in another run of the same
+scenario, half a book to the left or to the right explained six books each); colours tell such readings apart when the
 row's objects differ in colour and the views are close enough to measure it. The chosen offset
 is refined to the mean displacement of the percepts it explains.
 
@@ -91,6 +91,7 @@ class FrameOffset:
 
     @property
     def distance(self) -> float:
+        """How far (m) the frame's percepts were moved."""
         return float(np.linalg.norm(self.offset))
 
 
@@ -152,8 +153,8 @@ def _candidate_pairs(
     rows: list[int] = []
     slots: list[int] = []
     displacements: list[np.ndarray] = []
-    # The index searches in 3D; a horizontal offset of maximum_offset is at most that far in 3D
-    # once the height differs by little, and a pair with a larger height difference is not one.
+    # The index searches a ball: a ground robot's pose error moves nothing up or down, so a pair
+    # further apart than maximum_offset in 3D is no pair, whatever its horizontal part.
     for row, found in enumerate(index.within(positions, config.maximum_offset)):
         for slot, anchor in zip(found.tolist(), index.anchors_at(found), strict=True):
             percept = percepts[row]
