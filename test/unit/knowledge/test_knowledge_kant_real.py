@@ -85,9 +85,23 @@ def test_facts_other_writers_put_in_kant_read_as_declared(kant_location):
         assert Proposition("object_at", ("cup_1", "living_room"), provenance=Provenance.PERCEIVED) in facts
 
 
+def open_with_short_deadline(location: str, patience: float = 20.0):
+    """A store with the test's short deadline, on a node that is up. A new store is a new DDS
+    participant, and on a busy machine finding the node's services can take longer than that
+    deadline (CI, 3 December 2026: ``get_types did not appear within 1 s`` with the node running):
+    opening is retried until ``patience`` runs out; the deadline then measures the dead node only."""
+    give_up = time.monotonic() + patience
+    while True:
+        try:
+            return open_store(location, timeout=DEADLINE_SECONDS)
+        except KnowledgeError:
+            if time.monotonic() > give_up:
+                raise
+
+
 @pytest.mark.ros
 def test_a_dead_kant_node_is_an_error_within_the_deadline(kant_node):
-    store = open_store(kant_node.location, timeout=DEADLINE_SECONDS)
+    store = open_with_short_deadline(kant_node.location)
     try:
         store.apply([Change.save(item) for item in kitchen_scene()])
         kant_node.process.kill()
@@ -116,11 +130,11 @@ def test_a_read_whose_reply_is_lost_is_asked_again(kant_node, monkeypatch):
             never.wait(60.0)  # the first exchange never hears back
         return real_load(store)
 
-    with open_store(kant_node.location, timeout=DEADLINE_SECONDS) as writer:
+    with open_with_short_deadline(kant_node.location) as writer:
         writer.apply([Change.save(item) for item in kitchen_scene()])
     monkeypatch.setattr(KantStore, "_load", first_reply_lost)
     try:
-        with open_store(kant_node.location, timeout=DEADLINE_SECONDS) as reader:
+        with open_with_short_deadline(kant_node.location) as reader:
             assert reader.objects.get("kitchen") == PddlObject("kitchen", "wp")
     finally:
         never.set()
