@@ -17,7 +17,14 @@ from enum import Enum
 
 import numpy as np
 
-from merlin2_sailor.anchoring.colour_evidence import ColourModel, combined, with_view
+from merlin2_sailor.anchoring.colour_evidence import (
+    ColourBySize,
+    ColourModel,
+    combined,
+    combined_by_size,
+    with_sized_view,
+    with_view,
+)
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_size, vote_class, winning_class
 from merlin2_sailor.anchoring.gallery import add_view, from_bfloat16_bits, view_scales
@@ -73,6 +80,8 @@ class Anchor:
     where unknown (restored from an older snapshot). See :mod:`.far_view`."""
     colour: ColourModel | None = None
     """The colours of its whole views' own pixels (:mod:`.colour_evidence`); None before any."""
+    colour_by_size: ColourBySize | None = None
+    """The same views' colours by the size they were seen at: what a single view is held to."""
     colour_seen: float | None = None
     """When a whole view with a colour was last fused (None: never): how long the anchor's colour
     has gone unchecked, which is what an absence is measured from (colourless views of something
@@ -80,6 +89,10 @@ class Anchor:
     colour_disputed: bool = False
     """A whole view of another colour stood where this anchor was expected: until a view of its own
     colour is fused, views that show no colour cannot be it either."""
+    colour_suspected: float | None = None
+    """When a first whole view of another colour stood where it was expected (None: no such view
+    since its colour was last seen): a second one soon after rules the anchor out. Not kept in
+    snapshots: a restart forgets a suspicion a fraction of a second old."""
     visible: bool = False
     """Reacquired or acquired in the latest processed frame."""
     missed_frames: int = 0
@@ -136,6 +149,7 @@ class Anchor:
             position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
             whole_views=0 if partial else 1,
             colour=None if partial else with_view(None, percept.colour),
+            colour_by_size=None if partial else with_sized_view(None, percept.colour, view_scale(percept)),
             colour_seen=None if partial or percept.colour is None else percept.stamp,
             visible=True,
             perceived_position=position.copy(),
@@ -165,9 +179,11 @@ class Anchor:
             self.whole_views += 1
             self.size = fuse_size(self.size, percept.size, self.whole_views, config)
             self.colour = with_view(self.colour, percept.colour)
+            self.colour_by_size = with_sized_view(self.colour_by_size, percept.colour, view_scale(percept))
             if percept.colour is not None:
                 self.colour_seen = percept.stamp
                 self.colour_disputed = False
+                self.colour_suspected = None
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
         if embedding is not None and not partial:  # a part's look is not the object's (matching_table)
@@ -205,6 +221,7 @@ class Anchor:
                 self.gallery, self.gallery_scales = add_view(self.gallery, self.gallery_scales, view, float(scale),
                                                              config.gallery_size)
         self.colour = combined(self.colour, other.colour)
+        self.colour_by_size = combined_by_size(self.colour_by_size, other.colour_by_size)
         self.times_seen += other.times_seen
         self.last_seen = max(self.last_seen, other.last_seen)
         self.last_tracker_id = other.last_tracker_id or self.last_tracker_id

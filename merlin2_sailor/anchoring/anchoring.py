@@ -6,8 +6,9 @@ One frame (:meth:`Anchoring.process`) follows the paper's algorithm, then the li
 2. with no anchors, every percept is acquired; otherwise the matching table (gated, batched,
    :mod:`.matching_table`) is built and assigned (:mod:`.assignment`): a pair at or above
    ``match_threshold`` reacquires, every other percept acquires a new anchor (:mod:`.observation`),
-   unless it is a view too far to tell from an anchor not seen otherwise (:mod:`.far_view`): that
-   one is left unresolved;
+   unless it is a view too far to tell from an anchor not seen otherwise (:mod:`.far_view`), or a
+   first whole view of another colour where an anchor was (:mod:`.colour_evidence`): those are
+   left unresolved;
 3. an anchor not reacquired is checked against the camera: only if it should have been visible
    does it count towards MISSING; an expected place seen empty has its expectation RETRACTED;
 4. identity repair (:mod:`.identity_repair`): a newcomer that is a MISSING anchor seen again, by
@@ -40,7 +41,13 @@ from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.matching_table import Embedder, MatchingTableBuilder, MatchingTableConfig, with_embeddings
+from merlin2_sailor.anchoring.matching_table import (
+    Embedder,
+    MatchingTableBuilder,
+    MatchingTableConfig,
+    held_views,
+    with_embeddings,
+)
 from merlin2_sailor.anchoring.merge import apply_decision
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
@@ -206,6 +213,9 @@ class Anchoring:
         table = self._table_builder.build(percepts, self._index, whole)
         for anchor in table.disputed:
             anchor.colour_disputed = True
+        for anchor in table.suspected:
+            if self.config.colour.suspicion_stale(anchor.colour_suspected, stamp):
+                anchor.colour_suspected = stamp
         percepts = table.percepts
         assignment = assign(table.scores, self.config.match_threshold)
         symbols = [""] * len(percepts)
@@ -225,6 +235,7 @@ class Anchoring:
         taken = np.zeros(len(table.anchors), dtype=bool)
         taken[[int(column) for _, column in assignment.matches]] = True
         unresolved = unresolved_far_views(table, unmatched, taken, partial, config.match_threshold, config.far_view)
+        unresolved.update(held_views(table, unmatched, unresolved))
         unmatched = [row for row in unmatched if row not in unresolved]
         percepts = self._embed_for_gallery(percepts, [row for row in unmatched if not partial[row]])
         # New anchors of one class in one frame take their symbols in the order of their places, not

@@ -93,14 +93,19 @@ def nearest_anchor(table: MatchingTable, row: int, taken: np.ndarray) -> str:
     """The anchor of the percept's class that scored it best, with the score, how the view's size
     compares with that anchor's views, and whether another view of the frame took it (``taken``:
     (A,) bool, the columns reacquired): why a new anchor was made, for the acquired event (a
-    duplicate's first question). Empty when no anchor of its class passed the gate."""
+    duplicate's first question), then the anchors its colour ruled out (even when another anchor
+    scored it: the one it stood in the place of is the one that matters). Empty when no anchor of
+    its class passed the gate and none was ruled out."""
     percept = table.percepts[row]
     columns = [column for column, anchor in enumerate(table.anchors)
                if not table.gated[row, column] and anchor.class_name == percept.class_name]
+    # Gated by colour: the view's colour ruled out an anchor whose own went unchecked a while.
+    ruled_out = table.colour_ruled_out
+    by_colour = [] if ruled_out is None else sorted(table.anchors[column].symbol
+                                                    for column in np.flatnonzero(ruled_out[row]))
+    colour_text = f"{', '.join(by_colour)} ruled out by colour" if by_colour else ""
     if not columns:
-        # Gated by colour: the view's colour ruled out an anchor whose own went unchecked a while.
-        disputed = sorted(anchor.symbol for anchor in table.disputed if anchor.class_name == percept.class_name)
-        return f"{', '.join(disputed)} ruled out by colour" if disputed else ""
+        return colour_text
     column = max(columns, key=lambda candidate: table.scores[row, candidate])
     anchor = table.anchors[column]
     text = f"{anchor.symbol} scored {table.scores[row, column]:.2f}"
@@ -109,4 +114,4 @@ def nearest_anchor(table: MatchingTable, row: int, taken: np.ndarray) -> str:
         text += f", view {view_scale(percept) / smallest:.2f} of its smallest"
     if taken[column]:
         text += ", taken by another view"
-    return text
+    return f"{text}; {colour_text}" if colour_text else text

@@ -14,7 +14,8 @@ from merlin2_sailor.anchoring.frame_registration import FrameOffset
 @dataclass(frozen=True, slots=True, eq=False)
 class AnchoringResult:
     """What one call changed. ``percept_symbols[i]`` is the symbol percept i was anchored to, or ""
-    for a percept left unresolved (:mod:`.far_view`); ``unresolved`` names, per such percept, the
+    for a percept left unresolved (too far to tell, :mod:`.far_view`; or held apart by a first view
+    of another colour, :mod:`.colour_evidence`); ``unresolved`` names, per such percept, the
     anchor it may have been; ``frame_offset``: the shared pose error taken out of the frame's
     percepts before matching (:mod:`.frame_registration`), None when none was."""
 

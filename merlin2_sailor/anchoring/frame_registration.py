@@ -45,9 +45,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, view_differs
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs
 from merlin2_sailor.anchoring.expectation import ExpectationKind
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
@@ -159,7 +159,7 @@ def _candidate_pairs(
         for slot, anchor in zip(found.tolist(), index.anchors_at(found), strict=True):
             percept = percepts[row]
             if (anchor.class_name != percept.class_name or not _is_landmark(anchor, config.minimum_views)
-                    or view_differs(anchor.colour, percept.colour, colour)):
+                    or sized_view_differs(anchor.colour_by_size, percept.colour, view_scale(percept), colour)):
                 continue
             rows.append(row)
             slots.append(slot)

@@ -24,24 +24,26 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
 5. **appearance only from comparable views**: a partial view's crop is not compared with an
    anchor's views (:func:`.partial_view.comparable_views`), nor embedded for it;
 6. **colour evidence**: a whole view whose colour rules out an anchor unseen for a while (a
-   look-alike of another colour put in its place) is gated from it, whatever the matcher scored
-   (:func:`~.colour_evidence.view_differs`).
+   look-alike of another colour put in its place) is gated from it, whatever the matcher scored,
+   when the anchor's own views of about that view's size say so
+   (:func:`~.colour_evidence.sized_view_differs`) and a first such view a moment earlier did too;
+   that first view is only held apart from the anchor (``held``).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, view_differs
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.partial_view import comparable_views
@@ -138,6 +140,14 @@ class MatchingTable:
     embedded: int = 0
     disputed: tuple[Anchor, ...] = ()
     """Anchors a whole view of another colour was ruled out from (see :mod:`.colour_evidence`)."""
+    colour_ruled_out: np.ndarray | None = None
+    """(P, A) bool: the pairs gated by colour (None: no colour was asked), for the acquired event's
+    account of why a view got a new anchor."""
+    suspected: tuple[Anchor, ...] = ()
+    """Anchors a first whole view of another colour raised a suspicion about (see :mod:`.colour_evidence`)."""
+    held: np.ndarray | None = None
+    """(P, A) bool: the pairs such a first view held apart: gated too, and the view, unless another
+    anchor takes it, is left unresolved rather than anchored anew (None: no colour was asked)."""
 
 
 class MatchingTableBuilder:
@@ -220,13 +230,18 @@ class MatchingTableBuilder:
         scores[shortcut] = np.where(eligible[shortcut], self.config.tracker_continuity_score, self.config.gated_score)
         scores = apply_tracker_continuity(scores, continuations, same_class, self.config.tracker_continuity_score)
         disputed: tuple[Anchor, ...] = ()
+        suspected: tuple[Anchor, ...] = ()
+        ruled_out = held = None
         if whole is not None:
-            ruled_out, differing = self._ruled_out_by_colour(percepts, anchors, whole, ~gated)
-            scores[ruled_out] = self.config.gated_score
-            gated |= ruled_out
-            continuations &= ~ruled_out
+            ruled_out, differing, held = self._ruled_out_by_colour(percepts, anchors, whole, ~gated)
+            apart = ruled_out | held
+            scores[apart] = self.config.gated_score
+            gated |= apart
+            continuations &= ~apart
             disputed = tuple(anchors[column] for column in np.flatnonzero(differing.any(axis=0)))
-        return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded, disputed)
+            suspected = tuple(anchors[column] for column in np.flatnonzero(held.any(axis=0)))
+        return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded, disputed, ruled_out,
+                             suspected, held)
 
     def _ungated_pairs(self, percepts: PerceptColumns, index: AnchorIndex) -> tuple[np.ndarray, np.ndarray]:
         """(rows, slots) of the pairs that pass the gate, computed on the index's arrays only.
@@ -255,26 +270,33 @@ class MatchingTableBuilder:
 
     def _ruled_out_by_colour(
         self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: Sequence[bool], open_pairs: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(ruled out, differing), both (P, A): the pairs gated by colour, and among them those
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(ruled out, differing, held), each (P, A): the pairs gated by colour; among them those
         whose percept, a whole view with a colour, differed from an anchor whose colour had gone
-        unchecked for the configured absence; the others are views without a colour (far, cut off)
-        of what stands where a disputed anchor was."""
+        unchecked for the configured absence (or was disputed already) and confirmed a suspicion
+        a first such view raised (the others ruled out are views without a colour, far or cut
+        off, of what stands where a disputed anchor was); and the pairs of a view that differed
+        but only raised the suspicion."""
         ruled_out = np.zeros(open_pairs.shape, dtype=bool)
         differing = np.zeros(open_pairs.shape, dtype=bool)
+        held = np.zeros(open_pairs.shape, dtype=bool)
         if self.colour.minimum_views == 0 or not any(a.colour is not None or a.colour_disputed for a in anchors):
-            return ruled_out, differing  # no anchor has a colour to tell by: spare the loop over pairs
+            return ruled_out, differing, held  # no anchor has a colour to tell by: spare the loop over pairs
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
             if whole[row] and percept.colour is not None:
                 checked = anchor.colour_seen if anchor.colour_seen is not None else anchor.last_seen
                 if percept.stamp - checked >= self.colour.absence or anchor.colour_disputed:
-                    differing[row, column] = view_differs(anchor.colour, percept.colour, self.colour)
+                    if sized_view_differs(anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
+                        confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
+                            anchor.colour_suspected, percept.stamp)
+                        differing[row, column] = confirmed
+                        held[row, column] = not confirmed
                 ruled_out[row, column] = differing[row, column]
             else:
                 # Nothing coloured has been its colour there since: a colourless view is no way back.
                 ruled_out[row, column] = anchor.colour_disputed and anchor.state is AnchorState.MISSING
-        return ruled_out, differing
+        return ruled_out, differing, held
 
     def _embed_needed(self, percepts: tuple[Percept, ...], rows: np.ndarray) -> tuple[tuple[Percept, ...], int]:
         """Embed, in one call, the crops of the given percepts that have none yet."""
@@ -290,6 +312,15 @@ class MatchingTableBuilder:
         return MatchingTable(
             percepts, (), empty, empty.astype(bool), empty.astype(bool), np.zeros(len(percepts), dtype=bool)
         )
+
+
+def held_views(table: MatchingTable, unmatched: Sequence[int], unresolved: Mapping[int, Anchor]) -> dict[int, Anchor]:
+    """{percept row: the anchor it was held apart from} for the ``unmatched`` percepts a first view
+    of another colour held (not already ``unresolved``): neither that anchor's nor a new one's yet."""
+    if table.held is None:
+        return {}
+    return {row: table.anchors[int(np.argmax(table.held[row]))]
+            for row in unmatched if row not in unresolved and table.held[row].any()}
 
 
 def with_embeddings(percepts: tuple[Percept, ...], rows: Sequence[int], embedder: Embedder) -> tuple[Percept, ...]:

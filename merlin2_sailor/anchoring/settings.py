@@ -378,6 +378,14 @@ SETTINGS: tuple[Setting, ...] = (
                 "Seconds an anchor's colour must have gone unchecked (no whole view with a colour) before "
                 "one whole view of another colour rules out that it is the anchor's object (a look-alike "
                 "put in its place while the camera looked away); 0: always.", 0.0, 1e6),
+        Setting("colour_comparable_size", ("core", "colour", "comparable_size"),
+                "One whole view is held only to the anchor's whole views at most this many times larger "
+                "or smaller (square root of the box's area): a view's colour changes with the size it is seen "
+                "at; with fewer than colour_minimum_views such views nothing is ruled out.", 1.0, 100.0),
+        Setting("colour_second_view_after", ("core", "colour", "second_view_after"),
+                "Seconds after a first whole view of another colour (left unresolved: no new anchor, and not "
+                "the anchor's) that a second one must come to rule the anchor out; 0: the first one does.",
+                0.0, 60.0),
         Setting("far_view_scale_ratio", ("core", "far_view", "scale_ratio"),
                 "A view whose box (square root of its area) is under this share of every view in an anchor's "
                 "appearance gallery is too far to compare with it: unmatched, it is left unresolved (no new "

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.colour_evidence import ColourModel
+from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourModel
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.gallery import GALLERY_DTYPE
 from merlin2_sailor.errors import InvalidInputError
@@ -55,9 +55,9 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "class_votes": {name: float(votes) for name, votes in anchor.class_votes.items()},
         "position_variance": float(anchor.position_variance),
         "gallery": gallery,
-        "colour": None if anchor.colour is None else {
-            "views": int(anchor.colour.views), "mean": anchor.colour.mean.tolist(),
-            "squares": anchor.colour.squares.tolist()},
+        "colour": None if anchor.colour is None else _colour_data(anchor.colour),
+        "colour_by_size": None if anchor.colour_by_size is None else {
+            str(band): _colour_data(model) for band, model in sorted(anchor.colour_by_size.bands.items())},
         "colour_seen": anchor.colour_seen,
         "colour_disputed": bool(anchor.colour_disputed),
         "missed_frames": int(anchor.missed_frames),
@@ -92,6 +92,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             gallery=_gallery(data.get("gallery")),
             gallery_scales=_gallery_scales(data.get("gallery")),
             colour=_colour(data.get("colour")),
+            colour_by_size=_colour_by_size(data.get("colour_by_size")),
             colour_seen=None if data.get("colour_seen") is None else float(data["colour_seen"]),
             colour_disputed=bool(data.get("colour_disputed", False)),
             visible=False,
@@ -119,6 +120,21 @@ def _vector(values: Any, name: str) -> np.ndarray:
     if vector.shape != (3,) or not np.all(np.isfinite(vector)):
         raise ValueError(f"{name} must be 3 finite numbers, got {values!r}")
     return vector
+
+
+def _colour_data(model: ColourModel) -> dict[str, Any]:
+    return {"views": int(model.views), "mean": model.mean.tolist(), "squares": model.squares.tolist()}
+
+
+def _colour_by_size(data: Mapping[str, Any] | None) -> ColourBySize | None:
+    """A snapshot's colours by view size (None in snapshots written before they were kept: such an
+    anchor rules no single view out by colour until it has seen views again)."""
+    if data is None:
+        return None
+    bands = {int(band): _colour(model) for band, model in data.items()}
+    if any(model is None for model in bands.values()):
+        raise ValueError("colour_by_size must map size bands to colour models")
+    return ColourBySize(bands)  # type: ignore[arg-type]
 
 
 def _colour(data: Mapping[str, Any] | None) -> ColourModel | None:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import json
+import math
 
 import numpy as np
 import pytest
@@ -23,10 +24,13 @@ from merlin2_sailor.anchoring.colour_evidence import (
     colour_windows,
     colours_differ,
     combined,
+    combined_by_size,
     view_differs,
+    with_sized_view,
 )
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.colour_histogram import COLOUR_BINS, HUE_BINS
 
@@ -125,6 +129,10 @@ def test_configuration_is_checked() -> None:
         ColourEvidenceConfig(noise_factor=float("nan"))
     with pytest.raises(ConfigurationError, match="colour_absence"):
         ColourEvidenceConfig(absence=-1.0)
+    with pytest.raises(ConfigurationError, match="colour_comparable_size"):
+        ColourEvidenceConfig(comparable_size=0.5)
+    with pytest.raises(ConfigurationError, match="colour_second_view_after"):
+        ColourEvidenceConfig(second_view_after=-0.1)
 
 
 # --- in the anchoring core, with the rules ---------------------------------------------------
@@ -142,6 +150,21 @@ def see(anchoring, maker, items, start, frames=4, camera=True, positions=None):
         percepts = [maker.percept(item, stamp, position=(positions or {}).get(item.identity)) for item in items]
         result = anchoring.process(percepts, camera_view() if camera else None, stamp)
     return result
+
+
+#: Frames (at 15 Hz) that span colour's ``second_view_after``: a first view of another colour only
+#: raises a suspicion, a second one this long after rules the anchor out.
+SUSPICION_FRAMES = 1 + math.ceil(ColourEvidenceConfig().second_view_after / FRAME)
+
+
+def acquired_events(anchoring, maker, items, start):
+    """The ACQUIRED events of the frames that span a suspicion and its confirmation."""
+    events = []
+    for frame in range(SUSPICION_FRAMES):
+        stamp = start + frame * FRAME
+        result = anchoring.process([maker.percept(item, stamp) for item in items], camera_view(), stamp)
+        events += [event for event in result.events if event.kind is AnchorEventKind.ACQUIRED]
+    return events
 
 
 def search(anchoring, symbol, stamp):
@@ -212,7 +235,7 @@ def test_a_mug_of_another_colour_put_in_the_place_of_one_unseen_for_a_while_is_n
     green_in_place = SceneObject("green", "cup", KITCHEN, colour=mug_colour(other))
     anchoring, maker = rules(), PerceptMaker(seed=own)
     see(anchoring, maker, [red], 0.0)
-    result = see(anchoring, maker, [green_in_place], 60.0)
+    result = see(anchoring, maker, [green_in_place], 60.0, frames=SUSPICION_FRAMES + 3)
     assert result.percept_symbols == ("cup_2",)
     assert {anchor.symbol: anchor.state for anchor in anchoring.anchors} == {
         "cup_1": AnchorState.MISSING, "cup_2": AnchorState.CONFIRMED}
@@ -270,7 +293,7 @@ def test_views_without_colour_do_not_bring_back_an_anchor_a_view_of_another_colo
     anchoring, maker = rules(), PerceptMaker(seed=6)
     see(anchoring, maker, [red], 0.0)
     assert see(anchoring, maker, [green_far], 60.0, frames=2).percept_symbols == ("cup_1",)
-    assert see(anchoring, maker, [green], 61.0).percept_symbols == ("cup_2",)
+    assert see(anchoring, maker, [green], 61.0, frames=SUSPICION_FRAMES).percept_symbols == ("cup_2",)
     assert anchoring.get("cup_1").state is AnchorState.MISSING and anchoring.get("cup_1").colour_disputed
     assert see(anchoring, maker, [green_far], 62.0, frames=6).percept_symbols == ("cup_2",)
     assert anchoring.get("cup_1").state is AnchorState.MISSING
@@ -284,6 +307,118 @@ def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
     green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
     anchoring, maker = rules(), PerceptMaker(seed=6)
     see(anchoring, maker, [red], 0.0)
-    result = see(anchoring, maker, [green], 61.0, frames=1)
-    (acquired,) = [event for event in result.events if event.kind is AnchorEventKind.ACQUIRED]
+    (acquired,) = acquired_events(anchoring, maker, [green], 61.0)
     assert acquired.details["nearest_anchor"] == "cup_1 ruled out by colour"
+    # With another mug in reach, the account names both: the best score, and the one ruled out.
+    blue = SceneObject("blue", "cup", (2.6, 0.3, 0.8), colour=mug_colour(BLUE))
+    anchoring, maker = rules(), PerceptMaker(seed=6)
+    see(anchoring, maker, [red, blue], 0.0)
+    see(anchoring, maker, [blue], 60.0, frames=1)
+    (acquired,) = acquired_events(anchoring, maker, [green], 61.0)
+    assert acquired.details["nearest_anchor"].startswith("cup_2 scored ")
+    assert acquired.details["nearest_anchor"].endswith("; cup_1 ruled out by colour")
+
+
+# --- a single view is held to views of about its size -----------------------------------------
+
+
+def test_views_are_kept_by_size_and_compared_only_with_views_of_about_that_size() -> None:
+    rng = np.random.default_rng(4)
+    close, far = noisy_views(mug_colour(RED), 5, rng), noisy_views(mug_colour(RED), 4, rng)
+    by_size = None
+    for view in close:
+        by_size = with_sized_view(by_size, view, 120.0)
+    for view in far:
+        by_size = with_sized_view(by_size, view, 15.0)
+    by_size = with_sized_view(by_size, close[0], 0.0)  # an empty box has no size: left out
+    assert sum(model.views for model in by_size.bands.values()) == 9
+    assert by_size.comparable(100.0, 2.0).views == 5
+    assert by_size.comparable(20.0, 2.0).views == 4
+    assert by_size.comparable(45.0, 2.0) is None
+    assert by_size.comparable(45.0, 8.0).views == 9
+    # Merging two anchors' views keeps them by size, and the whole equals one model of every view.
+    other = with_sized_view(None, far[0], 15.0)
+    merged = combined_by_size(by_size, other)
+    assert merged.comparable(20.0, 2.0).views == 5 and by_size.comparable(20.0, 2.0).views == 4
+    everything = merged.comparable(45.0, 8.0)
+    expected = model_of([*close, *far, far[0]])
+    np.testing.assert_allclose(everything.mean, expected.mean)
+    np.testing.assert_allclose(everything.squares, expected.squares, atol=1e-12)
+
+
+def sized(percept, size: float):
+    return dataclasses.replace(percept, box=BoundingBox2D(80.0, 60.0, size, size))
+
+
+@pytest.mark.parametrize(("own", "other"), [(RED, GREEN), (GREEN, BLUE)])
+def test_views_of_another_colour_rule_out_an_anchor_only_at_about_the_size_it_was_seen(own: int, other: int) -> None:
+    """The anchor knows its colour from close views; a view three times smaller (from across the
+    room) blends outline and background, and its colour is no evidence against it: it reacquires
+    the anchor. At about the size the anchor was seen, a first such view is held apart and a
+    second one rules the anchor out."""
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(own))
+    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(other))
+    later = ColourEvidenceConfig().second_view_after + 0.1
+    for size, ruled_out in ((20.0, True), (30.0, True), (60.0, False), (6.5, False)):
+        anchoring, maker = rules(), PerceptMaker(seed=own + int(size))
+        see(anchoring, maker, [red], 0.0)
+        first = anchoring.process([sized(maker.percept(green, 60.0), size)], camera_view(), 60.0).percept_symbols
+        assert first == (("",) if ruled_out else ("cup_1",)), size
+        if ruled_out:
+            second = anchoring.process([sized(maker.percept(green, 60.0 + later), size)], camera_view(), 60.0 + later)
+            assert second.percept_symbols == ("cup_2",), size
+    # A wider comparable_size takes the far view as evidence again.
+    anchoring, maker = rules(ColourEvidenceConfig(comparable_size=4.0, second_view_after=0.0)), PerceptMaker(seed=3)
+    see(anchoring, maker, [red], 0.0)
+    assert anchoring.process([sized(maker.percept(green, 60.0), 60.0)], camera_view(), 60.0).percept_symbols == (
+        "cup_2",)
+
+
+def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it() -> None:
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
+    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
+    anchoring, maker = rules(), PerceptMaker(seed=12)
+    see(anchoring, maker, [red], 0.0)
+    first = anchoring.process([maker.percept(green, 60.0)], camera_view(), 60.0)
+    # Neither the anchor's (it is not reacquired by it) nor a new one; the anchor is not missing
+    # either: the view may be it.
+    assert first.percept_symbols == ("",) and first.unresolved == ("cup_1",)
+    cup = anchoring.get("cup_1")
+    assert cup.state is AnchorState.CONFIRMED and cup.colour_suspected == 60.0 and not cup.colour_disputed
+    assert [anchor.symbol for anchor in anchoring.anchors] == ["cup_1"]
+    # Too soon for a second view: still held, the suspicion still dates from the first.
+    assert anchoring.process([maker.percept(green, 60.1)], camera_view(), 60.1).percept_symbols == ("",)
+    assert cup.colour_suspected == 60.0
+    # A view of its own colour in between is fused, and ends the suspicion.
+    assert anchoring.process([maker.percept(red, 60.2)], camera_view(), 60.2).percept_symbols == ("cup_1",)
+    assert cup.colour_suspected is None
+    # After another absence: a suspicion too old to confirm (seconds later, another visit) is
+    # raised anew, and a second view soon after that one confirms it.
+    assert anchoring.process([maker.percept(green, 90.0)], camera_view(), 90.0).percept_symbols == ("",)
+    assert anchoring.process([maker.percept(green, 94.5)], camera_view(), 94.5).percept_symbols == ("",)
+    assert cup.colour_suspected == 94.5
+    result = anchoring.process([maker.percept(green, 94.9)], camera_view(), 94.9)
+    assert result.percept_symbols == ("cup_2",) and cup.colour_disputed
+    # second_view_after 0: the first view rules the anchor out, as colour evidence once did.
+    eager, maker = rules(ColourEvidenceConfig(second_view_after=0.0)), PerceptMaker(seed=12)
+    see(eager, maker, [red], 0.0)
+    assert eager.process([maker.percept(green, 60.0)], camera_view(), 60.0).percept_symbols == ("cup_2",)
+
+
+def test_colours_by_size_survive_a_snapshot_and_older_snapshots_still_load() -> None:
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
+    anchoring, maker = rules(), PerceptMaker(seed=5)
+    see(anchoring, maker, [red], 0.0)
+    anchoring.process([sized(maker.percept(red, 1.0), 70.0)], camera_view(), 1.0)
+    restored = rules()
+    restored.restore(json.loads(json.dumps(anchoring.snapshot())))
+    before, after = anchoring.get("cup_1").colour_by_size, restored.get("cup_1").colour_by_size
+    assert sorted(after.bands) == sorted(before.bands) and len(after.bands) == 2
+    for band, model in before.bands.items():
+        assert after.bands[band].views == model.views
+        np.testing.assert_allclose(after.bands[band].mean, model.mean)
+    snapshot = anchoring.snapshot()
+    del snapshot["anchors"][0]["colour_by_size"]
+    older = rules()
+    older.restore(snapshot)
+    assert older.get("cup_1").colour_by_size is None and older.get("cup_1").colour.views == 5

@@ -1,0 +1,136 @@
+"""Does one whole view's colour say "another object" when it is the same object seen at another size?
+
+Why: duplicate anchors in the scenario suite were made when one view's colour ruled out the
+object's own anchor (``nearest_anchor=... ruled out by colour``), the object then anchored anew on
+its own spot. This tours held-out generated houses (``sailor evaluate``'s houses, the demo's
+percept generator and ground-truth detector with instance masks; :mod:`merlin2_sailor_demos.identity.tour`),
+keeps every whole view with a colour, and asks, for each return to an object after
+``absence`` seconds or more (when one view may rule its anchor out):
+
+- how often the return's first view (and its first two) differs from the anchor's colour, held
+  to all of the anchor's views and to its views of about the view's size only
+  (``comparable_size``); and by how much the view's size differed from the anchor's typical one;
+- how often a view of *another* object of the class is ruled out (what the evidence is for), held
+  to all views and to comparable ones.
+
+Run (needs darknet's photos for the houses' textures, as ``sailor evaluate`` does)::
+
+    SAILOR_DARKNET_DATA=$(scripts/fetch_test_data.sh) .venv/bin/python scripts/colour_views_by_size.py [HOUSES]
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import view_scale
+from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenceConfig, ColourModel, view_differs
+from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
+from merlin2_sailor_demos.identity.house_source import HouseSource
+from merlin2_sailor_demos.identity.tour import Tour, TourConfig
+from merlin2_sailor_demos.world.world import World
+
+#: Frames per second of the tours: enough to see every object from each stop, cheap to render.
+TOUR_RATE_HZ = 3.0
+
+
+@dataclass(frozen=True, slots=True)
+class ColourView:
+    stamp: float
+    histogram: np.ndarray
+    size: float
+
+
+def whole_views(house: int, source: HouseSource) -> dict[str, list[ColourView]]:
+    """Every whole view with a colour of each object of held-out house ``house``, in time order."""
+    description, seed = source.house("test", house)
+    world = World(description, seed=seed, segment=True, darknet_data=source.darknet_data)
+    views: dict[str, list[ColourView]] = defaultdict(list)
+    for frame in Tour(world, TourConfig(rate_hz=TOUR_RATE_HZ)).frames():
+        partial = partial_views(frame.percepts, frame.camera, PartialViewConfig())
+        for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
+            if object_id is not None and not cut and percept.colour is not None:
+                views[f"{house}/{object_id}/{percept.class_name}"].append(
+                    ColourView(frame.stamp, np.asarray(percept.colour, dtype=np.float64), view_scale(percept)))
+    return views
+
+
+def model_of(views: list[ColourView]) -> ColourModel:
+    model = ColourModel.of(views[0].histogram)
+    for view in views[1:]:
+        model.add(view.histogram)
+    return model
+
+
+def by_size(views: list[ColourView]) -> ColourBySize:
+    model = ColourBySize()
+    for view in views:
+        model.add(view.histogram, view.size)
+    return model
+
+
+def differs(earlier: list[ColourView], view: ColourView, config: ColourEvidenceConfig, sized: bool) -> bool:
+    if sized:
+        return view_differs(by_size(earlier).comparable(view.size, config.comparable_size), view.histogram, config)
+    return view_differs(model_of(earlier), view.histogram, config)
+
+
+def main(houses: int) -> int:
+    config = ColourEvidenceConfig()
+    source = HouseSource()
+    objects: dict[str, list[ColourView]] = {}
+    for house in range(houses):
+        objects.update(whole_views(house, source))
+        print(f"toured house {house + 1}/{houses}: {len(objects)} objects so far", file=sys.stderr)
+    returns = 0
+    first = {False: 0, True: 0}
+    first_two = {False: 0, True: 0}
+    size_ratios: list[float] = []
+    for views in objects.values():
+        for index in range(config.minimum_views, len(views)):
+            if views[index].stamp - views[index - 1].stamp < config.absence:
+                continue
+            returns += 1
+            earlier = views[:index]
+            for sized in (False, True):
+                one = differs(earlier, views[index], config, sized)
+                first[sized] += one
+                if one and index + 1 < len(views):
+                    first_two[sized] += differs(earlier, views[index + 1], config, sized)
+            if differs(earlier, views[index], config, False):
+                typical = float(np.median([view.size for view in earlier]))
+                size_ratios.append(max(views[index].size / typical, typical / views[index].size))
+    print(f"returns to an object after >= {config.absence:g} s: {returns}")
+    print(f"  first view differs, held to all views: {first[False]}; to views of about its size "
+          f"(x{config.comparable_size:g}): {first[True]}")
+    print(f"  first two views differ: all views {first_two[False]}; comparable {first_two[True]}")
+    if size_ratios:
+        print("  size of a differing first view against the anchor's median view (times larger or smaller): "
+              + ", ".join(f"{ratio:.1f}" for ratio in sorted(size_ratios)))
+    tests = ruled_all = ruled_sized = comparable = 0
+    for name, views in objects.items():
+        house, _, class_name = name.split("/")
+        if len(views) < config.minimum_views:
+            continue
+        whole, sized_model = model_of(views), by_size(views)
+        for other, other_views in objects.items():
+            if other == name or other.split("/")[0] != house or other.split("/")[2] != class_name:
+                continue
+            for view in other_views[::max(1, len(other_views) // 20)]:
+                tests += 1
+                ruled_all += view_differs(whole, view.histogram, config)
+                near = sized_model.comparable(view.size, config.comparable_size)
+                if near is not None and near.views >= config.minimum_views:
+                    comparable += 1
+                    ruled_sized += view_differs(near, view.histogram, config)
+    print(f"views of another object of the class: {tests}; ruled out by all views: {ruled_all} "
+          f"({100.0 * ruled_all / max(tests, 1):.0f} %); with comparable views: {comparable}, of them ruled out "
+          f"{ruled_sized} ({100.0 * ruled_sized / max(comparable, 1):.0f} %)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(int(sys.argv[1]) if len(sys.argv) > 1 else 20))
