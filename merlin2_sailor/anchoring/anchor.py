@@ -19,6 +19,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.colour_evidence import (
     ColourBySize,
+    ColourEvidenceConfig,
     ColourModel,
     combined,
     combined_by_size,
@@ -227,6 +228,25 @@ class Anchor:
         self.last_tracker_id = other.last_tracker_id or self.last_tracker_id
         self.visible = other.visible
         self.provenance = Provenance.PERCEIVED
+
+    def colour_unchecked(self, stamp: float, config: ColourEvidenceConfig) -> bool:
+        """Whether its colour has gone unchecked for ``config.absence`` at ``stamp`` (no whole view
+        with a colour fused since), or a view of another colour disputed it: whether a view's
+        colour is now a question of identity (:mod:`.colour_evidence`)."""
+        checked = self.colour_seen if self.colour_seen is not None else self.last_seen
+        return stamp - checked >= config.absence or self.colour_disputed
+
+    def colour_untellable(self, percept: Percept, config: ColourEvidenceConfig) -> bool:
+        """Whether the anchor knows its colour (``minimum_views`` whole views) but has too few views
+        of about the percept's size to hold the percept's colour to: such a view's colour says
+        nothing for or against it, as if it had none (a far view of the green mug standing where
+        the red one was seen only close up must neither rule the red anchor out nor be fused into
+        its colour)."""
+        if config.minimum_views == 0 or self.colour is None or self.colour.views < config.minimum_views:
+            return False
+        near = None if self.colour_by_size is None else self.colour_by_size.comparable(view_scale(percept),
+                                                                                     config.comparable_size)
+        return near is None or near.views < config.minimum_views
 
     @property
     def is_active(self) -> bool:

@@ -21,6 +21,7 @@ anchors themselves; this class keeps no bookkeeping of its own beyond the index.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -225,7 +226,13 @@ class Anchoring:
             anchor = table.anchors[column]
             unknown[row] = anchor.state is AnchorState.TENTATIVE
             before = anchor.position.copy()
-            reacquire(anchor, percepts[row], changes, config.fusion, config.lifecycle, config.expectation_tolerance,
+            percept = percepts[row]
+            if percept.colour is not None and anchor.colour_unchecked(stamp, config.colour) \
+                    and anchor.colour_untellable(percept, config.colour):
+                # Its colour cannot be held to the anchor's: it neither checks the anchor's colour
+                # nor joins it (it may be another object's, standing in its place).
+                percept = dataclasses.replace(percept, colour=None)
+            reacquire(anchor, percept, changes, config.fusion, config.lifecycle, config.expectation_tolerance,
                       continued=bool(table.continuations[row, column]), partial=partial[row])
             note_jump(anchor, before, stamp, config.repair.place_jump, config.repair.place_review)
             self._index.refresh(anchor)

@@ -284,17 +284,17 @@ class MatchingTableBuilder:
             return ruled_out, differing, held  # no anchor has a colour to tell by: spare the loop over pairs
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
-            if whole[row] and percept.colour is not None:
-                checked = anchor.colour_seen if anchor.colour_seen is not None else anchor.last_seen
-                if percept.stamp - checked >= self.colour.absence or anchor.colour_disputed:
-                    if sized_view_differs(anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
-                        confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
-                            anchor.colour_suspected, percept.stamp)
-                        differing[row, column] = confirmed
-                        held[row, column] = not confirmed
+            if whole[row] and percept.colour is not None and not anchor.colour_untellable(percept, self.colour):
+                if anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
+                        anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
+                    confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
+                        anchor.colour_suspected, percept.stamp)
+                    differing[row, column] = confirmed
+                    held[row, column] = not confirmed
                 ruled_out[row, column] = differing[row, column]
             else:
-                # Nothing coloured has been its colour there since: a colourless view is no way back.
+                # Nothing coloured has been its colour there since: a view without a colour, or with
+                # one that cannot be held to the anchor's, is no way back.
                 ruled_out[row, column] = anchor.colour_disputed and anchor.state is AnchorState.MISSING
         return ruled_out, differing, held
 

@@ -91,10 +91,13 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             position_variance=float(data["position_variance"]),
             gallery=_gallery(data.get("gallery")),
             gallery_scales=_gallery_scales(data.get("gallery")),
-            colour=_colour(data.get("colour")),
+            # A snapshot written before colours were kept by view size: its colour is learnt
+            # afresh (a colour no view could be held to would never be checked again).
+            colour=_colour(data.get("colour")) if "colour_by_size" in data else None,
             colour_by_size=_colour_by_size(data.get("colour_by_size")),
-            colour_seen=None if data.get("colour_seen") is None else float(data["colour_seen"]),
-            colour_disputed=bool(data.get("colour_disputed", False)),
+            colour_seen=None if data.get("colour_seen") is None or "colour_by_size" not in data
+            else float(data["colour_seen"]),
+            colour_disputed=bool(data.get("colour_disputed", False)) and "colour_by_size" in data,
             visible=False,
             missed_frames=int(data.get("missed_frames", 0)),
             recovery_sightings=int(data.get("recovery_sightings", 0)),
@@ -127,8 +130,8 @@ def _colour_data(model: ColourModel) -> dict[str, Any]:
 
 
 def _colour_by_size(data: Mapping[str, Any] | None) -> ColourBySize | None:
-    """A snapshot's colours by view size (None in snapshots written before they were kept: such an
-    anchor rules no single view out by colour until it has seen views again)."""
+    """A snapshot's colours by view size (None in snapshots written before they were kept, or
+    when the anchor had no colour)."""
     if data is None:
         return None
     bands = {int(band): _colour(model) for band, model in data.items()}

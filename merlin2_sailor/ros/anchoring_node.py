@@ -127,7 +127,7 @@ class AnchoringNode(Node):
         self._anchoring_thread.start()
         self._reported_drops = 0
         self._reported_embedding = (0, 0)
-        self._unresolved: Counter[str] = Counter()  # anchor -> views too far to tell from it, this period
+        self._unresolved: Counter[str] = Counter()  # anchor -> views not yet told from it, this period
         self._offsets: list[float] = []  # pose errors (m) taken out of frames this period
         self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report)
 
@@ -202,13 +202,15 @@ class AnchoringNode(Node):
         self._report_offsets()
 
     def _report_unresolved(self) -> None:
-        """Views left unresolved in the last period (too far to tell from an anchor: far_view)."""
+        """Views left unresolved in the last period: too far to tell from an anchor (far_view), or a
+        first view of another colour where it stood (colour_evidence)."""
         if not self._unresolved:
             return
         counts, self._unresolved = self._unresolved, Counter()
         anchors = ", ".join(f"{symbol} ({views})" for symbol, views in sorted(counts.items()))
-        self.get_logger().info(f"views in the last {DROP_REPORT_PERIOD_SECONDS:g} s too far to tell whether they "
-                               f"show {anchors}: left unresolved until a closer view")
+        self.get_logger().info(f"views in the last {DROP_REPORT_PERIOD_SECONDS:g} s that could not yet be told from "
+                               f"{anchors} (too far to tell, or a first view of another colour): left unresolved "
+                               "until a closer or a second view")
 
     def _report_offsets(self) -> None:
         """Frames whose shared pose error was taken out in the last period (frame_registration):

@@ -374,6 +374,34 @@ def test_views_of_another_colour_rule_out_an_anchor_only_at_about_the_size_it_wa
         "cup_2",)
 
 
+def test_a_view_that_cannot_be_held_to_the_anchors_colour_neither_checks_nor_joins_it() -> None:
+    """The swap seen first from afar: the green mug stands where the red one was, seen only close
+    up. Its far views reacquire the red anchor (the rules read place and time), but their colour
+    does not join the red mug's nor restart its clock; the first views at the red mug's size rule
+    the anchor out. Without that, the far views made the red anchor's colour half green and the
+    mission claimed the green mug (`swapped`, rules, seed 0, 3 December)."""
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
+    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
+    anchoring, maker = rules(), PerceptMaker(seed=21)
+    see(anchoring, maker, [red], 0.0)
+    cup = anchoring.get("cup_1")
+    views, seen = cup.colour.views, cup.colour_seen
+    for frame in range(8):
+        stamp = 60.0 + frame * FRAME
+        result = anchoring.process([sized(maker.percept(green, stamp), 60.0)], camera_view(), stamp)
+        assert result.percept_symbols == ("cup_1",)
+    assert cup.colour.views == views and cup.colour_seen == seen
+    assert sum(model.views for model in cup.colour_by_size.bands.values()) == views
+    symbols = [anchoring.process([sized(maker.percept(green, 61.0 + frame * FRAME), 20.0)], camera_view(),
+                                 61.0 + frame * FRAME).percept_symbols for frame in range(SUSPICION_FRAMES)]
+    assert symbols[0] == ("",) and symbols[-1] == ("cup_2",)
+    # While its colour is fresh, views of every size join it: approaching an object fills its sizes in.
+    anchoring, maker = rules(), PerceptMaker(seed=22)
+    see(anchoring, maker, [red], 0.0)
+    anchoring.process([sized(maker.percept(red, 1.0), 60.0)], camera_view(), 1.0)
+    assert len(anchoring.get("cup_1").colour_by_size.bands) == 2
+
+
 def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it() -> None:
     red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
     green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
@@ -405,7 +433,7 @@ def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it()
     assert eager.process([maker.percept(green, 60.0)], camera_view(), 60.0).percept_symbols == ("cup_2",)
 
 
-def test_colours_by_size_survive_a_snapshot_and_older_snapshots_still_load() -> None:
+def test_colours_by_size_survive_a_snapshot_and_older_snapshots_learn_colour_afresh() -> None:
     red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
     anchoring, maker = rules(), PerceptMaker(seed=5)
     see(anchoring, maker, [red], 0.0)
@@ -421,4 +449,5 @@ def test_colours_by_size_survive_a_snapshot_and_older_snapshots_still_load() -> 
     del snapshot["anchors"][0]["colour_by_size"]
     older = rules()
     older.restore(snapshot)
-    assert older.get("cup_1").colour_by_size is None and older.get("cup_1").colour.views == 5
+    # Its colour is learnt afresh: one no view could be held to would never be checked again.
+    assert older.get("cup_1").colour_by_size is None and older.get("cup_1").colour is None
