@@ -50,8 +50,13 @@ view of a return differed from the object's own anchor in 19 returns held to all
 them 2.3-4.1 times larger or smaller than the anchor's median view; held to views of about its
 size, in 9. A view of another object of the class was ruled out as often either way (80 % of
 13,315 tests against all views; 80 % of the 12,094 that had comparable views).
-Merges compare two anchors' whole models, as before: their
-means over many views are not one view.
+A view that cannot be held to the anchor's colour (none of its views is of about its size) is, for
+that anchor, a view without a colour: while the anchor's colour is unchecked it neither checks it
+nor joins it (:meth:`~.anchor.Anchor.colour_untellable`); far views of a green mug standing where
+the red one was seen close up once reacquired the red anchor and made its colour half green, and
+the mission claimed the green mug (`swapped`, rules, seed 0). While the colour is fresh, views of
+every size join it, so an object approached fills its sizes in. Merges compare two anchors' whole
+models, as before: their means over many views are not one view.
 
 And one view is not enough: a first view of another colour only raises a suspicion (the anchor is
 not reacquired by it, and the view makes no new anchor: it is left unresolved); a second such view
