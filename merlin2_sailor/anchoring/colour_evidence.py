@@ -58,6 +58,12 @@ the mission claimed the green mug (`swapped`, rules, seed 0). While the colour i
 every size join it, so an object approached fills its sizes in. Merges compare two anchors' whole
 models, as before: their means over many views are not one view.
 
+Only a view standing in the anchor's place (within ``place_radius``, 0.5 m) counts against it: the
+matching table's gate reaches 3 m or more, and a view of the hall's book 3 m from the kitchen's
+cookbook, of another colour as it should be, once disputed the cookbook's anchor, so that a later
+odd view of the cookbook itself ruled it out at once (`swapped`, rules, seed 0, 3 December). A view
+elsewhere is another object or the object moved; the matcher and the merges judge those.
+
 And one view is not enough: a first view of another colour only raises a suspicion (the anchor is
 not reacquired by it, and the view makes no new anchor: it is left unresolved); a second such view
 at least ``second_view_after`` seconds later, while the camera has moved on a little, rules the
@@ -91,7 +97,8 @@ class ColourEvidenceConfig:
     another colour rules it out; ``comparable_size``: how many times larger or smaller (square
     root of the box's area) the anchor's views may be than a single view they are compared with;
     ``second_view_after`` (s): how long after a first view of another colour a second one must
-    come before they rule the anchor out (0: the first one does)."""
+    come before they rule the anchor out (0: the first one does); ``place_radius`` (m): how near
+    (horizontally) to the anchor a single view must stand for its colour to count against it."""
 
     minimum_views: int = 3
     minimum_difference: float = 0.1
@@ -99,6 +106,7 @@ class ColourEvidenceConfig:
     absence: float = 10.0
     comparable_size: float = 2.0
     second_view_after: float = 0.3
+    place_radius: float = 0.5
 
     def __post_init__(self) -> None:
         if self.minimum_views < 0:
@@ -117,6 +125,8 @@ class ColourEvidenceConfig:
             raise ConfigurationError(
                 f"anchoring colour_comparable_size must be >= 1 (a size ratio), got {self.comparable_size}."
             )
+        if not (math.isfinite(self.place_radius) and self.place_radius > 0.0):
+            raise ConfigurationError(f"anchoring colour_place_radius must be > 0 metres, got {self.place_radius}.")
         if not (math.isfinite(self.second_view_after) and self.second_view_after >= 0.0):
             raise ConfigurationError(
                 f"anchoring colour_second_view_after must be >= 0 seconds, got {self.second_view_after}."

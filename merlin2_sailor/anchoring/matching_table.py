@@ -272,8 +272,9 @@ class MatchingTableBuilder:
         self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: Sequence[bool], open_pairs: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(ruled out, differing, held), each (P, A): the pairs gated by colour; among them those
-        whose percept, a whole view with a colour, differed from an anchor whose colour had gone
-        unchecked for the configured absence (or was disputed already) and confirmed a suspicion
+        whose percept, a whole view with a colour standing in the anchor's place, differed from an
+        anchor whose colour had gone unchecked for the configured absence (or was disputed
+        already) and confirmed a suspicion
         a first such view raised (the others ruled out are views without a colour, far or cut
         off, of what stands where a disputed anchor was); and the pairs of a view that differed
         but only raised the suspicion."""
@@ -285,7 +286,9 @@ class MatchingTableBuilder:
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
             if whole[row] and percept.colour is not None and not anchor.colour_untellable(percept, self.colour):
-                if anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
+                in_place = float(np.hypot(*(np.asarray(percept.position[:2]) - anchor.position[:2]))) \
+                    <= self.colour.place_radius
+                if in_place and anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
                         anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
                     confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
                         anchor.colour_suspected, percept.stamp)

@@ -131,6 +131,8 @@ def test_configuration_is_checked() -> None:
         ColourEvidenceConfig(absence=-1.0)
     with pytest.raises(ConfigurationError, match="colour_comparable_size"):
         ColourEvidenceConfig(comparable_size=0.5)
+    with pytest.raises(ConfigurationError, match="colour_place_radius"):
+        ColourEvidenceConfig(place_radius=0.0)
     with pytest.raises(ConfigurationError, match="colour_second_view_after"):
         ColourEvidenceConfig(second_view_after=-0.1)
 
@@ -400,6 +402,24 @@ def test_a_view_that_cannot_be_held_to_the_anchors_colour_neither_checks_nor_joi
     see(anchoring, maker, [red], 0.0)
     anchoring.process([sized(maker.percept(red, 1.0), 60.0)], camera_view(), 1.0)
     assert len(anchoring.get("cup_1").colour_by_size.bands) == 2
+
+
+def test_only_a_view_in_the_anchors_place_counts_against_it() -> None:
+    """Another book of another colour 2 m away is within the table's reach of the long-unseen
+    cookbook, and of course differs: it is another object, not a dispute of the cookbook (which once
+    let one odd view of the cookbook itself rule its anchor out: `swapped`, rules, seed 0)."""
+    red_book = SceneObject("cookbook", "book", KITCHEN, colour=mug_colour(RED))
+    green_book = SceneObject("hall book", "book", (4.0, 0.3, 0.8), colour=mug_colour(GREEN))
+    anchoring, maker = rules(), PerceptMaker(seed=31)
+    see(anchoring, maker, [red_book], 0.0)
+    see(anchoring, maker, [green_book], 60.0, frames=SUSPICION_FRAMES + 2)
+    cookbook = anchoring.get("book_1")
+    assert not cookbook.colour_disputed and cookbook.colour_suspected is None
+    # The same view where the cookbook stood is one.
+    see(anchoring, maker, [], 61.0, frames=1)
+    moved_in = SceneObject("hall book", "book", KITCHEN, colour=mug_colour(GREEN))
+    assert see(anchoring, maker, [moved_in], 62.0, frames=SUSPICION_FRAMES).percept_symbols == ("book_3",)
+    assert cookbook.colour_disputed
 
 
 def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it() -> None:
