@@ -58,7 +58,8 @@ the mission claimed the green mug (`swapped`, rules, seed 0). While the colour i
 every size join it, so an object approached fills its sizes in. Merges compare two anchors' whole
 models, as before: their means over many views are not one view.
 
-Only a view standing in the anchor's place (within ``place_radius``, 0.5 m) counts against it: the
+Only a view standing in the anchor's place (within ``place_radius``, 0.5 m, and nearer to it than
+to any other anchor of its class: on a shelf, a book's view is not its neighbour's) counts against it: the
 matching table's gate reaches 3 m or more, and a view of the hall's book 3 m from the kitchen's
 cookbook, of another colour as it should be, once disputed the cookbook's anchor, so that a later
 odd view of the cookbook itself ruled it out at once (`swapped`, rules, seed 0, 3 December). A view
@@ -98,7 +99,8 @@ class ColourEvidenceConfig:
     root of the box's area) the anchor's views may be than a single view they are compared with;
     ``second_view_after`` (s): how long after a first view of another colour a second one must
     come before they rule the anchor out (0: the first one does); ``place_radius`` (m): how near
-    (horizontally) to the anchor a single view must stand for its colour to count against it."""
+    (horizontally) to the anchor a single view must stand for its colour to count against it
+    (nearer to no other anchor of its class, too)."""
 
     minimum_views: int = 3
     minimum_difference: float = 0.1

@@ -283,12 +283,11 @@ class MatchingTableBuilder:
         held = np.zeros(open_pairs.shape, dtype=bool)
         if self.colour.minimum_views == 0 or not any(a.colour is not None or a.colour_disputed for a in anchors):
             return ruled_out, differing, held  # no anchor has a colour to tell by: spare the loop over pairs
+        in_place = self._in_place(percepts, anchors)
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
             if whole[row] and percept.colour is not None and not anchor.colour_untellable(percept, self.colour):
-                in_place = float(np.hypot(*(np.asarray(percept.position[:2]) - anchor.position[:2]))) \
-                    <= self.colour.place_radius
-                if in_place and anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
+                if in_place[row, column] and anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
                         anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
                     confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
                         anchor.colour_suspected, percept.stamp)
@@ -300,6 +299,25 @@ class MatchingTableBuilder:
                 # one that cannot be held to the anchor's, is no way back.
                 ruled_out[row, column] = anchor.colour_disputed and anchor.state is AnchorState.MISSING
         return ruled_out, differing, held
+
+    def _in_place(self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...]) -> np.ndarray:
+        """(P, A) bool: the percept stands in the anchor's place: within ``place_radius``
+        horizontally, and no neighbour of the anchor's class is nearer to it (on a shelf, a book's
+        view is its own anchor's, not its neighbour's place). A neighbour is an anchor that already
+        existed when the anchor's colour was last checked: one born since, perhaps of the very
+        object in its place (a look-alike anchored there once ruled out), is no neighbour."""
+        positions = np.array([percept.position[:2] for percept in percepts], dtype=np.float64).reshape(-1, 2)
+        places = np.array([anchor.position[:2] for anchor in anchors], dtype=np.float64).reshape(-1, 2)
+        distance = np.linalg.norm(positions[:, np.newaxis, :] - places[np.newaxis, :, :], axis=2)
+        classes = np.array([anchor.class_name for anchor in anchors], dtype=object)
+        born = np.array([anchor.first_seen for anchor in anchors], dtype=np.float64)
+        checked = np.array([anchor.colour_seen if anchor.colour_seen is not None else anchor.last_seen
+                            for anchor in anchors], dtype=np.float64)
+        # neighbour[k, a]: anchor k is a neighbour of anchor a
+        neighbour = (classes[:, np.newaxis] == classes[np.newaxis, :]) & (born[:, np.newaxis] <= checked[np.newaxis, :])
+        np.fill_diagonal(neighbour, False)
+        nearest_neighbour = np.where(neighbour[np.newaxis, :, :], distance[:, :, np.newaxis], np.inf).min(axis=1)
+        return (distance <= self.colour.place_radius) & (distance <= nearest_neighbour)
 
     def _embed_needed(self, percepts: tuple[Percept, ...], rows: np.ndarray) -> tuple[tuple[Percept, ...], int]:
         """Embed, in one call, the crops of the given percepts that have none yet."""

@@ -384,8 +384,8 @@ SETTINGS: tuple[Setting, ...] = (
                 "at; with fewer than colour_minimum_views such views nothing is ruled out.", 1.0, 100.0),
         Setting("colour_place_radius", ("core", "colour", "place_radius"),
                 "How near (m, horizontally) to an anchor one whole view must stand for its colour to count "
-                "against it (a view elsewhere is another object, or the object moved: the matcher and the "
-                "merges judge those).", 0.01, 100.0),
+                "against it, nearer to no other anchor of its class (a view elsewhere is another object, or "
+                "the object moved: the matcher and the merges judge those).", 0.01, 100.0),
         Setting("colour_second_view_after", ("core", "colour", "second_view_after"),
                 "Seconds after a first whole view of another colour (left unresolved: no new anchor, and not "
                 "the anchor's) that a second one must come to rule the anchor out; 0: the first one does.",

@@ -422,6 +422,19 @@ def test_only_a_view_in_the_anchors_place_counts_against_it() -> None:
     assert cookbook.colour_disputed
 
 
+def test_a_books_view_is_not_held_against_its_neighbour_on_the_shelf() -> None:
+    """Two books of different colours 0.2 m apart, both unseen for a minute: each one's view stands
+    within 0.5 m of the other's anchor, but nearer its own; neither is disputed, even when only one
+    of them is seen."""
+    red_book = SceneObject("red", "book", KITCHEN, colour=mug_colour(RED))
+    green_book = SceneObject("green", "book", (KITCHEN[0], KITCHEN[1] + 0.2, KITCHEN[2]), colour=mug_colour(GREEN))
+    anchoring, maker = rules(), PerceptMaker(seed=32)
+    see(anchoring, maker, [red_book, green_book], 0.0)
+    assert see(anchoring, maker, [red_book], 60.0, frames=SUSPICION_FRAMES + 2).percept_symbols == ("book_1",)
+    neighbour = anchoring.get("book_2")
+    assert not neighbour.colour_disputed and neighbour.colour_suspected is None
+
+
 def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it() -> None:
     red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
     green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
