@@ -182,6 +182,9 @@ class ColourModel:
         self.mean = self.mean + delta / self.views
         self.squares = self.squares + delta * (windows - self.mean)
 
+    def copy(self) -> ColourModel:
+        return ColourModel(self.views, self.mean.copy(), self.squares.copy())
+
     def merged(self, other: ColourModel) -> ColourModel:
         views = self.views + other.views
         delta = other.mean - self.mean
@@ -208,7 +211,7 @@ def combined(first: ColourModel | None, second: ColourModel | None) -> ColourMod
     """Both models as one (an anchor merged into another)."""
     if first is None or second is None:
         known = first or second
-        return None if known is None else ColourModel(known.views, known.mean.copy(), known.squares.copy())
+        return None if known is None else known.copy()
     return first.merged(second)
 
 
@@ -304,18 +307,16 @@ class ColourBySize:
                   if size / ratio <= band_centre(band) <= size * ratio]
         if not chosen:
             return None
-        result = ColourModel(chosen[0].views, chosen[0].mean.copy(), chosen[0].squares.copy())
+        result = chosen[0].copy()
         for model in chosen[1:]:
             result = result.merged(model)
         return result
 
     def merged(self, other: ColourBySize) -> ColourBySize:
         """Both anchors' views, band by band (an anchor merged into another)."""
-        bands = {band: ColourModel(model.views, model.mean.copy(), model.squares.copy())
-                 for band, model in self.bands.items()}
+        bands = {band: model.copy() for band, model in self.bands.items()}
         for band, model in other.bands.items():
-            bands[band] = bands[band].merged(model) if band in bands else \
-                ColourModel(model.views, model.mean.copy(), model.squares.copy())
+            bands[band] = bands[band].merged(model) if band in bands else model.copy()
         return ColourBySize(bands)
 
 
