@@ -13,6 +13,7 @@ import logging
 import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -23,6 +24,10 @@ from merlin2_sailor.inference.settings import InferenceSettings
 OPENVINO_HINT = "Install the OpenVINO runtime (`pip install openvino==2026.4.1`; scripts/setup.sh does)."
 
 _logger = logging.getLogger(__name__)
+
+#: Changes a read model before it is compiled (for example, pre-processing folded into its graph);
+#: typed loosely, ``openvino.Model -> openvino.Model``, as openvino is imported lazily.
+ModelPreparation = Callable[[Any], Any]
 _core_lock = threading.Lock()
 _core = None
 
@@ -71,12 +76,16 @@ class CompiledNetwork:
     """
 
     def __init__(self, model_path: Path, settings: InferenceSettings,
-                 report: Callable[[str], None] | None = None) -> None:
+                 report: Callable[[str], None] | None = None, prepare: ModelPreparation | None = None) -> None:
         core = openvino_core()
         report = report or _logger.warning
         self.device = choose_device(settings.device, core.available_devices, report)
+
+        def model():  # -> openvino.Model or the path, which lets OpenVINO reuse its compiled blob
+            return prepare(core.read_model(str(model_path))) if prepare else str(model_path)
+
         try:
-            self._compiled = core.compile_model(str(model_path), self.device, _configuration(settings, self.device))
+            self._compiled = core.compile_model(model(), self.device, _configuration(settings, self.device))
         except Exception as error:  # OpenVINO raises RuntimeError subclasses of its own
             if self.device == "CPU":
                 raise DependencyError(
@@ -85,7 +94,7 @@ class CompiledNetwork:
             report(f"inference device {self.device} failed to load {model_path.parent.name} "
                    f"({' '.join(str(error).split())[:200]}); running on the CPU")
             self.device = "CPU"
-            self._compiled = core.compile_model(str(model_path), "CPU", _configuration(settings, "CPU"))
+            self._compiled = core.compile_model(model(), "CPU", _configuration(settings, "CPU"))
         self._request = self._compiled.create_infer_request()
         self._lock = threading.Lock()
         self._output_names = tuple(frozenset(port.get_names()) for port in self._compiled.outputs)

@@ -68,15 +68,16 @@ def colour_histogram(pixels: np.ndarray) -> np.ndarray:
     saturation = hsv[:, 1] / 255.0
     value = hsv[:, 2] / 255.0
     chromatic = (saturation > CHROMATIC_SATURATION) & (value > CHROMATIC_VALUE)
-    histogram = np.zeros(COLOUR_BINS, dtype=np.float64)
-    # Bin centres sit at i + 0.5; share each hue between the two centres around it.
+    # Bin centres sit at i + 0.5; share each hue between the two centres around it. (bincount,
+    # not np.add.at: the same sums, a tenth of the time.)
     position = hue[chromatic] - 0.5
     lower = np.floor(position)
-    upper_share = position - lower
-    np.add.at(histogram, lower.astype(np.intp) % HUE_BINS, 1.0 - upper_share)
-    np.add.at(histogram, (lower.astype(np.intp) + 1) % HUE_BINS, upper_share)
+    upper_share = (position - lower).astype(np.float64)
+    lower_bin = lower.astype(np.intp) % HUE_BINS
     grey_bin = np.minimum((value[~chromatic] * GREY_BINS).astype(np.intp), GREY_BINS - 1)
-    np.add.at(histogram, HUE_BINS + grey_bin, 1.0)
+    histogram = (np.bincount(lower_bin, weights=1.0 - upper_share, minlength=COLOUR_BINS)
+                 + np.bincount((lower_bin + 1) % HUE_BINS, weights=upper_share, minlength=COLOUR_BINS)
+                 + np.bincount(HUE_BINS + grey_bin, minlength=COLOUR_BINS))
     return (histogram / histogram.sum()).astype(np.float32)
 
 

@@ -6,12 +6,13 @@ magnitude is part of what the network was trained on, and normalising here would
 change its inputs. Callers that want a cosine similarity normalise themselves.
 
 Each crop is resized to the backbone's input (224 px square, aspect ratio not kept, as in the
-paper) and normalised with the ImageNet mean and standard deviation. Crops go through the network
-in batches. On a CPU small batches pay best: measured on one core (``bench/bench_embedding.py``),
-batches of 4 cost per crop about what single crops do, while batches of 16 cost ~40 % more,
-because their activations no longer fit in the cache; on an accelerator large batches win. The
-backbone runs through OpenVINO by default (an export of the same torch module, several times
-faster on a CPU; see :mod:`.openvino_backbone`), or in torch with ``inference.runtime: native``.
+paper) and normalised with the ImageNet mean and standard deviation by the backbone itself
+(OpenVINO folds that into its graph). Crops go through the network in batches. On a CPU small
+batches pay best: measured on one core (``bench/bench_embedding.py``), batches of 4 cost per crop
+about what single crops do, while batches of 16 cost ~40 % more, because their activations no
+longer fit in the cache; on an accelerator large batches win. The backbone runs through OpenVINO
+by default (an export of the same torch module, several times faster on a CPU; see
+:mod:`.openvino_backbone`), or in torch with ``inference.runtime: native``.
 
 Each embedding ends with the crop's colour descriptor (:mod:`.colour_histogram`: 42 values, the
 histograms of its centre and its surround) unless ``colour_histogram`` is off: pooled ImageNet
@@ -62,8 +63,6 @@ class CropEmbedder:
         self.config = config or EmbeddingConfig()
         self.backbone = backbone or create_backbone(
             self.config.backbone, self.config.weights_path, self.config.inference, report)
-        self._mean = np.asarray(self.backbone.mean, dtype=np.float32) * 255.0
-        self._inverse_std = 1.0 / (np.asarray(self.backbone.std, dtype=np.float32) * 255.0)
 
     @property
     def colour_bins(self) -> int:
@@ -90,16 +89,16 @@ class CropEmbedder:
         features = np.empty((len(crops), self.feature_dimension), dtype=np.float32)
         backbone_dimension = self.backbone.feature_dimension
         for start in range(0, len(crops), self.config.batch_size):
-            batch = self._preprocess(crops[start : start + self.config.batch_size], start)
+            batch = self._resized(crops[start : start + self.config.batch_size], start)
             features[start : start + len(batch), :backbone_dimension] = self.backbone.features(batch)
         if self.colour_bins:
             features[:, backbone_dimension:] = colour_descriptors(crops)
         return features
 
-    def _preprocess(self, crops: Sequence[np.ndarray], first_index: int) -> np.ndarray:
-        """Resize, normalise and stack crops into an (N, 3, S, S) float32 batch."""
+    def _resized(self, crops: Sequence[np.ndarray], first_index: int) -> np.ndarray:
+        """Resize and stack crops into an (N, S, S, 3) uint8 batch (the backbone normalises them)."""
         size = self.backbone.input_size
-        batch = np.empty((len(crops), size, size, 3), dtype=np.float32)
+        batch = np.empty((len(crops), size, size, 3), dtype=np.uint8)
         for offset, crop in enumerate(crops):
             crop = np.asarray(crop)
             if crop.ndim != 3 or crop.shape[2] != 3 or crop.dtype != np.uint8 or crop.shape[0] < 1 or crop.shape[1] < 1:
@@ -111,6 +110,4 @@ class CropEmbedder:
             shrinking = crop.shape[0] * crop.shape[1] > size * size
             interpolation = cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR
             batch[offset] = cv2.resize(crop, (size, size), interpolation=interpolation)
-        batch -= self._mean
-        batch *= self._inverse_std
-        return np.ascontiguousarray(batch.transpose(0, 3, 1, 2))
+        return batch
