@@ -69,13 +69,21 @@ class PersistenceSettings:
                 raise ConfigurationError(f"persistence {name} must be a positive number of seconds, got {value}.")
 
 
+#: The most percept arrays the node keeps waiting: more would anchor frames ever further behind the
+#: camera, each judged against a camera pose and depth image that must still be buffered.
+MAXIMUM_FRAME_BACKLOG = 30
+
+
 @dataclass(frozen=True, slots=True)
 class TimingSettings:
-    """The node's clockwork: ``track_period`` (s between Track steps) and ``stamp_tolerance`` (the
-    largest gap, s, between percepts and the camera pose / depth image they are judged with)."""
+    """The node's clockwork: ``track_period`` (s between Track steps), ``stamp_tolerance`` (the
+    largest gap, s, between percepts and the camera pose / depth image they are judged with) and
+    ``frame_backlog`` (percept arrays kept waiting while a frame is anchored, the oldest let go
+    beyond: a burst of new objects to embed is caught up on rather than its sightings lost)."""
 
     track_period: float = 0.5
     stamp_tolerance: float = 0.05
+    frame_backlog: int = 4
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.track_period) and self.track_period > 0.0):
@@ -83,6 +91,9 @@ class TimingSettings:
                 f"timing track_period must be a positive number of seconds, got {self.track_period}.")
         if not (math.isfinite(self.stamp_tolerance) and self.stamp_tolerance >= 0.0):
             raise ConfigurationError(f"timing stamp_tolerance must be >= 0 seconds, got {self.stamp_tolerance}.")
+        if not 1 <= self.frame_backlog <= MAXIMUM_FRAME_BACKLOG:
+            raise ConfigurationError(
+                f"timing frame_backlog must be 1 to {MAXIMUM_FRAME_BACKLOG} frames, got {self.frame_backlog}.")
 
 
 POSE_SOURCES = ("topic", "tf")
@@ -450,6 +461,11 @@ SETTINGS: tuple[Setting, ...] = (
         Setting("stamp_tolerance", ("timing", "stamp_tolerance"),
                 "Largest gap (s) between the percepts and the camera pose / depth image they are judged "
                 "with; without a pose that close, no anchor is marked missing that frame.", 0.0, 1.0),
+        Setting("frame_backlog", ("timing", "frame_backlog"),
+                "Percept arrays kept waiting while the node anchors a frame (1: only the newest); beyond it "
+                "the oldest is dropped and counted. A few frames let a burst of new objects (each crop to "
+                "embed) be caught up on instead of losing the sightings that confirm them; the price is "
+                "latency during the burst.", 1, MAXIMUM_FRAME_BACKLOG),
         Setting("pose_source", ("inputs", "pose_source"),
                 "Camera pose from topic (PoseStamped on camera_pose, the optical frame in world_frame) or from "
                 "tf (TF through tf2_ros: the camera info's frame in world_frame at each percept stamp; a frame "

@@ -99,7 +99,9 @@ class AnchoringNode(Node):
         self._intrinsics: CameraIntrinsics | None = None
         tolerance = settings.timing.stamp_tolerance
         self._poses: StampedBuffer[Pose] = StampedBuffer(tolerance=tolerance)
-        self._depths: StampedBuffer[np.ndarray] = StampedBuffer(capacity=5, tolerance=tolerance)
+        # A depth image for each frame waiting, and for the one being anchored.
+        self._depths: StampedBuffer[np.ndarray] = StampedBuffer(capacity=settings.timing.frame_backlog + 2,
+                                                                tolerance=tolerance)
         self._robot_pose: Pose | None = None
 
         self._anchors_publisher = self.create_publisher(AnchorArray, "anchors", LATCHED)
@@ -120,9 +122,10 @@ class AnchoringNode(Node):
         self.create_service(srv.ForgetAnchor, "~/forget_anchor", self._forget_anchor)
         self.create_service(srv.ExpectAnchor, "~/expect_anchor", self._expect_anchor)
         self.create_timer(settings.timing.track_period, self._track)
-        # Percept arrays go to a worker through a one-slot mailbox: when anchoring falls behind
-        # the camera, the newest frame wins and the replaced ones are counted and reported.
-        self._mailbox = NewestFrameMailbox()
+        # Percept arrays go to a worker through a mailbox of a few frames: a burst of work is caught
+        # up on; when anchoring falls further behind the camera, the oldest waiting frames are let
+        # go, counted and reported.
+        self._mailbox = NewestFrameMailbox(settings.timing.frame_backlog)
         self._anchoring_thread = threading.Thread(target=self._anchor_frames, name="anchoring", daemon=True)
         self._anchoring_thread.start()
         self._reported_drops = 0
@@ -238,7 +241,8 @@ class AnchoringNode(Node):
         if dropped > self._reported_drops:
             self.get_logger().warning(
                 f"{dropped - self._reported_drops} percept arrays dropped in the last "
-                f"{DROP_REPORT_PERIOD_SECONDS:g} s while busy (the newest frame wins; {dropped} since start)")
+                f"{DROP_REPORT_PERIOD_SECONDS:g} s while busy ({self._mailbox.capacity} kept waiting, the oldest "
+                f"let go; {dropped} since start)")
             self._reported_drops = dropped
 
     def _anchor_frame(self, message: PerceptArray) -> None:

@@ -228,6 +228,16 @@ def test_the_newest_frame_wins_and_replaced_frames_are_counted() -> None:
     assert not worker.is_alive() and taken == [None]
 
 
+def test_a_mailbox_of_several_frames_catches_up_on_a_burst_and_lets_the_oldest_go() -> None:
+    mailbox = NewestFrameMailbox(capacity=3)
+    for frame in range(5):  # a burst: the worker is busy with an earlier frame
+        mailbox.put(frame)
+    assert mailbox.dropped == 2  # frames 0 and 1, the oldest, let go
+    assert [mailbox.take() for _ in range(3)] == [2, 3, 4]  # the rest in the order they came
+    with pytest.raises(ValueError, match="at least one frame"):
+        NewestFrameMailbox(capacity=0)
+
+
 # --- the perceptual chain -----------------------------------------------------------------------
 
 
