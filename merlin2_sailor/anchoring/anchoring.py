@@ -197,17 +197,26 @@ class Anchoring:
 
     # --- the frame loop ---------------------------------------------------------------------
 
-    def process(self, percepts: Sequence[Percept], camera: CameraView | None, stamp: float) -> AnchoringResult:
-        """Anchor one frame's percepts; ``camera`` (or None) says what the camera could see."""
+    def process(self, percepts: Sequence[Percept], camera: CameraView | None, stamp: float,
+                partial: Sequence[bool] | None = None) -> AnchoringResult:
+        """Anchor one frame's percepts; ``camera`` (or None) says what the camera could see.
+
+        ``partial``: per percept, whether it is cut by the image's edge or an occluder, from a
+        caller that knows (a replay of generated scenes, whose renderer says so); by default it is
+        told from the camera (:func:`.partial_view.partial_views`)."""
         check_percepts(percepts, stamp, self.config.world_frame)
+        if partial is not None and len(partial) != len(percepts):
+            raise InvalidInputError(f"{len(partial)} partial-view flags for {len(percepts)} percepts.")
         changes = FrameChanges(stamp)
         self._latest_stamp = max(self._latest_stamp, stamp)
         forget_expired(self._index, changes, self.config.lifecycle)
         previously_visible = self._index.visible()
 
-        partial = partial_views(percepts, camera, self.config.partial_view)
-        # Without a camera nothing says which views are whole, so no single view is colour evidence.
-        whole = None if camera is None else [not flag for flag in partial]
+        told = partial is not None
+        partial = [bool(flag) for flag in partial] if told else partial_views(percepts, camera,
+                                                                              self.config.partial_view)
+        # Unless something says which views are whole, no single view is colour evidence.
+        whole = None if camera is None and not told else [not flag for flag in partial]
         # The pose error all of this frame's percepts share is taken out before anything is judged.
         frame_offset = register_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
         percepts = shift_percepts(percepts, frame_offset)

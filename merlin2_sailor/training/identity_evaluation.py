@@ -94,7 +94,9 @@ def evaluate_identities(
                 )
                 for row, o in enumerate(observations)
             ]
-            result = anchoring.process(percepts, None, sample.stamp)
+            # The renderer knows which views are cut by the image's edge or an occluder, as the node
+            # tells from its camera: those are scored without their look, here as on the robot.
+            result = anchoring.process(percepts, None, sample.stamp, [o.partial for o in observations])
             truth = [o.instance for o in observations]
             # A percept left unresolved (a view too far to tell, merlin2_sailor.anchoring.far_view) names no anchor:
             # its object counts as missed in that frame, never as a symbol.

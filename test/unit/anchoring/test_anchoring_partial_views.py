@@ -21,7 +21,7 @@ from merlin2_sailor.anchoring.partial_view import (
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
 from merlin2_sailor.contract.percept import BoundingBox2D
-from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
 from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, camera_view, flat_depth
 
@@ -201,3 +201,24 @@ def test_an_anchor_knowing_only_part_of_a_lost_large_object_is_compared_without_
                                      fusion)
     [told_apart] = identity_scores(AppearanceRules(), [other_look], lost)
     assert told_apart < 0.5 * identity_scores(RuleMatcher(), [other_look], lost)[0]
+
+
+def test_a_caller_that_knows_which_views_are_cut_says_so_without_a_camera(maker) -> None:
+    """A replay of rendered scenes has no camera image to tell a cut view by, but its renderer knows
+    which views are cut: told so, the core scores such a view without its look, as the node does
+    from its camera; not told, the same view is a whole view whose look says another object."""
+    cut_box = BoundingBox2D.from_corners(10.0, 40.0, 40.0, 80.0)  # only its flag says it is cut
+    whole = looks(maker, "bicycle")
+    part = view_of(maker, BICYCLE, 0.3, cut_box, centre=(3.0, 0.4, 0.5), size=(0.35, 1.0, 1.0))
+    part = dataclasses.replace(part, embedding=looks(maker, "a bicycle's near end"))
+    outcomes = {}
+    for told in (True, False):
+        anchoring = Anchoring(AnchoringConfig(), matcher=AppearanceRules())
+        for frame in range(3):
+            view = dataclasses.replace(view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX), embedding=whole)
+            anchoring.process([view], None, frame * 0.1, partial=[False] if told else None)
+        outcomes[told] = anchoring.process([part], None, 0.3, partial=[True] if told else None)
+    assert outcomes[True].percept_symbols == ("bicycle_1",) and not outcomes[True].acquired
+    assert outcomes[False].acquired, "untold, the cut view's look must count (else this test shows nothing)"
+    with pytest.raises(InvalidInputError, match="2 partial-view flags for 1 percepts"):
+        Anchoring(AnchoringConfig(), matcher=AppearanceRules()).process([part], None, 0.3, partial=[True, False])
