@@ -81,7 +81,7 @@ class CompiledNetwork:
         report = report or _logger.warning
         self.device = choose_device(settings.device, core.available_devices, report)
 
-        def model():  # -> openvino.Model or the path, which lets OpenVINO reuse its compiled blob
+        def model():  # -> openvino.Model or its path; OpenVINO's CACHE_DIR keeps the compiled blob of either
             return prepare(core.read_model(str(model_path))) if prepare else str(model_path)
 
         try:

@@ -46,7 +46,7 @@ class Backbone(ABC):
     def normalised(self, pixels: np.ndarray) -> np.ndarray:
         """(N, S, S, 3) float32: the pixels on 0..255 normalised with the ImageNet statistics, channels
         last (what a runtime without its own normalisation feeds its network, transposed as it needs)."""
-        batch = np.asarray(pixels, dtype=np.float32)
+        batch = np.array(pixels, dtype=np.float32)  # a copy: the caller's pixels stay as they were
         batch -= np.asarray(self.mean, dtype=np.float32) * 255.0
         batch *= 1.0 / (np.asarray(self.std, dtype=np.float32) * 255.0)
         return batch

@@ -19,7 +19,7 @@ import numpy as np
 
 from merlin2_sailor.errors import DependencyError
 from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, ensure_exported, fingerprint
-from merlin2_sailor.inference.openvino_runtime import CompiledNetwork
+from merlin2_sailor.inference.openvino_runtime import CompiledNetwork, ModelPreparation
 from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.backbone import Backbone, TorchBackbone
 from merlin2_sailor.perception.backbone_weights import backbone_weights_file
@@ -60,7 +60,7 @@ def ensure_backbone(name: str, build_torch: TorchBackboneFactory, weights_path: 
                            f"the {name} backbone", needs_torch=True, folder=folder, report=report)
 
 
-def pixel_input(mean: tuple[float, ...], std: tuple[float, ...]):  # -> ModelPreparation
+def pixel_input(mean: tuple[float, ...], std: tuple[float, ...]) -> ModelPreparation:
     """A preparation giving an exported backbone (float (N, 3, S, S) normalised input) a uint8
     (N, S, S, 3) pixel input, the conversion, normalisation and transposition done in its graph."""
 
