@@ -50,7 +50,7 @@ class TrainingConfig:
     of the demo's house scored over 0.9 against the red one, with 1 the red mug itself only 0.62
     against its own anchor seen from afar; with 2, 0.87 against 0.66 for the green mug."""
 
-    epochs: int = 10
+    epochs: int = 3
     batch_size: int = 256
     learning_rate: float = 0.001
     final_learning_rate: float = 1e-5
