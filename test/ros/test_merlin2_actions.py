@@ -35,8 +35,10 @@ def test_ctrl_c_withdraws_every_action_once_and_exits_0(start_kant_node, ros_pro
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, text=True,
     )
     try:
-        assert ros_probe.wait_for(lambda: set(registered_actions(kant.location)) == set(ACTIONS),
-                                  timeout=START_SECONDS), "the actions never appeared in KANT"
+        if not ros_probe.wait_for(lambda: set(registered_actions(kant.location)) == set(ACTIONS),
+                                  timeout=START_SECONDS):
+            process.kill()
+            pytest.fail(f"the actions never appeared in KANT; the actions' process said:\n{process.communicate()[0]}")
         # Each with its own duration, in KANT's whole seconds.
         assert registered_actions(kant.location) == {
             name: float(kant_duration(SAILOR_ACTIONS[name].pddl.duration)) for name in ACTIONS}
