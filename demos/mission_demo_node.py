@@ -71,6 +71,7 @@ from merlin2_sailor_demos.report import (
     write_report,
 )
 from merlin2_sailor_demos.report.annotated_frame import AnchorInView, annotate_frame
+from merlin2_sailor_demos.report.naming import symbols_before_change
 from merlin2_sailor_demos.report.scorecard import CLAIMING_STATES
 from merlin2_sailor_demos.report.truth_timeline import TruthTimeline, refers_to
 from merlin2_sailor_demos.world import load_world
@@ -284,25 +285,13 @@ class MissionDemoNode(Node):
 
     def _identify_target(self) -> str | None:
         """The symbol of the anchor where the target was put at the start: the user pointing at it
-        (the world may already have moved it: it does so as soon as the robot is away). Every other
-        object is named the same way, so the report can tell whose symbol went where."""
+        (the rules: :func:`symbols_before_change`). Every other object is named the same way, so
+        the report can tell whose symbol went where."""
         time.sleep(SETTLE_SECONDS)  # the last look's anchors are confirmed a moment after it ends
         with self._lock:
-            confirmed = [a for a in self._anchors if a.state == "confirmed"]
-            missing = [a for a in self._anchors if a.state in CLAIMING_STATES and a.state != "confirmed"]
-        # Confirmed anchors are the fresher evidence; a missing anchor still names what the robot
-        # saw there, so it names an object no confirmed anchor does (the mug's anchor missing for
-        # three frames as the look ended, on a loaded machine, reacquired a moment later).
-        self._symbols_before = associate(self._initial_truth, confirmed)
-        unnamed = [obj for obj in self._initial_truth if obj.id not in self._symbols_before]
-        self._symbols_before.update(associate(unnamed, missing))
-        if self._target not in self._symbols_before:
-            # Moved in view before it could be named (a move the camera watches may begin while the
-            # robot still looks around): its anchor followed it, so it is named where it stands now.
-            # Only then: an object moved unseen is named where it was, where its anchor still is.
-            taken = set(self._symbols_before.values())
-            now = [obj for obj in self._truth() if obj.id == self._target]
-            self._symbols_before.update(associate(now, [a for a in confirmed if a.symbol not in taken]))
+            anchors = list(self._anchors)
+        target_now = next((obj for obj in self._truth() if obj.id == self._target), None)
+        self._symbols_before = symbols_before_change(self._initial_truth, target_now, anchors)
         symbol = self._symbols_before.get(self._target)
         self._say(f"the {self._target.replace('_', ' ')} is anchored as {symbol}" if symbol
                   else f"the {self._target.replace('_', ' ')} was not anchored while exploring")
