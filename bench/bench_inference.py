@@ -29,7 +29,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import json
-import os
 import subprocess
 import textwrap
 from collections.abc import Callable
@@ -37,6 +36,7 @@ from collections.abc import Callable
 import numpy as np
 from harness import script
 from harness.results import BenchmarkResult, Table, median_seconds
+from harness.scene import photo_folder
 
 from merlin2_sailor.anchoring.features import PairFeatures
 from merlin2_sailor.anchoring.matcher_registry import MatcherSettings, create_matcher
@@ -44,7 +44,6 @@ from merlin2_sailor.inference.settings import DETECTOR_PRECISIONS, PRECISIONS, I
 from merlin2_sailor.perception.detector_registry import create_detector
 from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig
 
-PHOTOS_FOLDER = Path(os.environ.get("SAILOR_DARKNET_DATA") or "/usr/share/darknet/data")
 PHOTOS = ("dog", "person", "horses", "giraffe", "kite", "eagle")
 RUNTIMES = {"openvino": "OpenVINO", "native": "torch / OpenCV DNN"}
 
@@ -53,13 +52,14 @@ def load_photos() -> list[np.ndarray]:
     """The darknet photos as RGB; random pixels where the package is missing (the figures say so)."""
     import cv2
 
+    folder = photo_folder()
     photos = []
     for name in PHOTOS:
-        image = cv2.imread(str(PHOTOS_FOLDER / f"{name}.jpg"))
+        image = cv2.imread(str(folder / f"{name}.jpg"))
         if image is not None:
             photos.append(cv2.cvtColor(cv2.resize(image, (640, 480)), cv2.COLOR_BGR2RGB))
     if not photos:
-        print(f"  no photos in {PHOTOS_FOLDER} (scripts/fetch_test_data.sh fetches them): random frames", flush=True)
+        print(f"  no photos in {folder} (scripts/fetch_test_data.sh fetches them): random frames", flush=True)
         photos = [np.random.default_rng(k).integers(0, 255, (480, 640, 3), np.uint8) for k in range(3)]
     return photos
 

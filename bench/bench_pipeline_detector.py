@@ -19,7 +19,10 @@ EfficientNet-Lite0). It runs twice, each run with the shipped configuration othe
 
 Per path and phase (15 Hz, then 30 Hz): latency image stamp -> AnchorArray (p50, p95, max), frames
 the detector dropped (newest wins: what it cannot keep up with), frames dropped after it (what the
-target forbids), and each node's CPU and resident memory. Targets (issue 16), for the new paths at
+target forbids), where a frame's time goes (image stamp -> DetectionArray, PerceptArray and
+AnchorArray reaching the probe), and each node's CPU and resident memory. The objects show the
+darknet photos (:func:`harness.scene.photo_folder`); without them the detector would find nothing,
+so the benchmark refuses to run and says how to fetch them. Targets (issue 16), for the new paths at
 15 Hz: no frame dropped after the detector and p95 < 100 ms. Nothing is asserted.
 
 Run: python bench/bench_pipeline_detector.py [--quick] [--duration S] [--node-log PATH] [--json PATH]
@@ -36,6 +39,7 @@ from harness import script
 from harness.pipeline_analysis import analyse, match
 from harness.pipeline_run import PipelineConfig, Recording, isolate_ros_domain, phases_of, run_pipeline
 from harness.results import BenchmarkResult, Table
+from harness.scene import require_photos
 
 OBJECTS = 10
 TARGET_PHASE = "15 Hz"
@@ -64,10 +68,34 @@ def detector_dropped(recording: Recording, phase_index: int) -> tuple[int, int]:
     stamps = np.sort(frames[:, 0])
     measured = frames[(frames[:, 1] == phase_index) & (frames[:, 2] == 1), 0]
     seen = np.zeros(len(stamps), dtype=bool)
-    indices = match(stamps, sorted(recording.detections))
+    indices = match(stamps, sorted(stamp for _, stamp in recording.detections))
     seen[indices[indices >= 0]] = True
     positions = np.searchsorted(stamps, measured)
     return len(measured), int((~seen[positions]).sum())
+
+
+def first_received_ms(recording: Recording, phase_index: int, outputs: list[tuple[int, int]]) -> list[float]:
+    """Image stamp -> first (received, stamp) output for it, in ms, over the phase's measured frames."""
+    frames = np.array(recording.played["frames"], dtype=np.int64).reshape(-1, 3)
+    stamps = np.sort(frames[:, 0])
+    measured = set(frames[(frames[:, 1] == phase_index) & (frames[:, 2] == 1), 0].tolist())
+    ordered = sorted(outputs, key=lambda output: output[1])
+    first: dict[int, int] = {}
+    for index, (received, _) in zip(match(stamps, [stamp for _, stamp in ordered]), ordered, strict=True):
+        if index >= 0 and int(stamps[index]) in measured:
+            first.setdefault(int(stamps[index]), received)
+    return [(received - stamp) * 1e-6 for stamp, received in first.items()]
+
+
+def stage_row(recording: Recording, phase_index: int, stats) -> list:
+    """Where a frame's time goes: p50 / p95 from the image stamp to each stage's output reaching the probe."""
+    detections = first_received_ms(recording, phase_index, recording.detections)
+    percepts = [(received, stamp) for received, stamp, _ in recording.percepts]
+    percepts = first_received_ms(recording, phase_index, percepts)
+    cells = []
+    for latencies in (detections, percepts, stats.latencies_ms):
+        cells.append(f"{np.percentile(latencies, 50):.0f} / {np.percentile(latencies, 95):.0f}" if latencies else "-")
+    return cells
 
 
 def run_path(runtime: str, phases, quick: bool, node_log: Path | None) -> tuple[Recording, list]:
@@ -86,6 +114,7 @@ def run_path(runtime: str, phases, quick: bool, node_log: Path | None) -> tuple[
 
 
 def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None) -> BenchmarkResult:
+    print(f"  photos for the detector: {require_photos()}", flush=True)
     seconds = duration or (12.0 if quick else 60.0)
     phases = phases_of([(TARGET_PHASE, 15.0, seconds, min(4.0, seconds / 3)),
                         ("30 Hz", 30.0, seconds / 2, min(3.0, seconds / 6))])
@@ -98,7 +127,7 @@ def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None
         parameters={"objects": OBJECTS, "phases": [p.__dict__ for p in phases]},
     )
     runs = {runtime: run_path(runtime, phases, quick, node_log) for runtime in PATHS}
-    rows, nodes = [], []
+    rows, nodes, stages = [], [], []
     for index, phase in enumerate(phases):
         figures = {}
         for runtime, (recording, statistics) in runs.items():
@@ -111,6 +140,7 @@ def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None
             rows.append([phase.label, PATHS[runtime], frames, round(stats.output_rate_hz, 1), at_detector,
                          after_detector, round(stats.latency(0.5), 1), round(stats.latency(0.95), 1),
                          round(max(stats.latencies_ms, default=math.nan), 1), stats.anchors_at_end])
+            stages.append([phase.label, PATHS[runtime], *stage_row(recording, index, stats)])
             for label, trend in sorted(stats.memory.items()):
                 if label in recording.config.node_labels:
                     nodes.append([phase.label, PATHS[runtime], label, round(trend.cpu_percent, 1),
@@ -124,6 +154,9 @@ def run(quick: bool = False, duration: float = 0.0, node_log: Path | None = None
         "per path and phase (measured frames; latency = image stamp -> AnchorArray published)",
         ["phase", "path", "frames", "AnchorArray Hz", "dropped at detector", "dropped after detector", "p50 ms",
          "p95 ms", "max ms", "anchors"], rows))
+    result.tables.append(Table(
+        "where the time goes (ms from the image stamp, p50 / p95, to each stage's output reaching the probe)",
+        ["phase", "path", "DetectionArray", "PerceptArray", "AnchorArray"], stages))
     result.tables.append(Table("per node (CPU: % of one core; peak resident memory)",
                                ["phase", "path", "node", "CPU %", "peak RSS MB"], nodes))
     return result

@@ -92,7 +92,7 @@ class Recording:
     pids: dict[str, int]
     outcomes: list[dict[str, Any]]
     log: list[str] = field(default_factory=list)
-    detections: list[int] = field(default_factory=list)  # DetectionArray stamps, with the detector
+    detections: list[tuple[int, int]] = field(default_factory=list)  # (received, header stamp), with the detector
 
     @property
     def ended_cleanly(self) -> bool:
@@ -136,7 +136,7 @@ class Probe:
         self.percepts: list[tuple[int, int, int]] = []
         self.anchors: list[tuple[int, int, int, int]] = []
         self.events: list[tuple[int, tuple[int, ...]]] = []
-        self.detections: list[int] = []  # header stamps of the detector's DetectionArrays (when it runs)
+        self.detections: list[tuple[int, int]] = []  # (received, header stamp) of the detector's DetectionArrays
         self._spinner = BackgroundSpinner("bench-probe")
         node = self._spinner.add_node(
             rclpy.create_node("bench_probe", namespace=f"/{namespace}", context=self._spinner.context))
@@ -150,7 +150,7 @@ class Probe:
         node.create_subscription(DetectionArray, "detections", self._on_detections, deep_best_effort)
 
     def _on_detections(self, message: DetectionArray) -> None:
-        self.detections.append(stamp_ns(message.header.stamp))
+        self.detections.append((time.time_ns(), stamp_ns(message.header.stamp)))
 
     def _on_percepts(self, raw: bytes) -> None:
         received = time.time_ns()

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from harness.script import CannotRun
 from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.contract.pose import Pose
@@ -99,18 +100,48 @@ def make_scene(object_count: int, seed: int = 0, width: int = WIDTH, height: int
 
 #: Real photos of COCO objects (Debian darknet; scripts/fetch_test_data.sh): what the detector finds.
 PHOTO_NAMES = ("dog", "horses", "person", "giraffe", "eagle", "kite")
+#: Where scripts/fetch_test_data.sh unpacks them in this checkout, when the system has no darknet package.
+CHECKOUT_PHOTOS = Path(__file__).resolve().parents[2] / "build" / "test-data" / "usr" / "share" / "darknet" / "data"
+
+
+class NoPhotosError(CannotRun):
+    """The benchmark needs the darknet photos and none were found."""
+
+
+def photo_folder() -> Path:
+    """The darknet photo folder: ``SAILOR_DARKNET_DATA`` when set, else the system's package, else
+    the copy ``scripts/fetch_test_data.sh`` unpacked into this checkout (the one ``make test`` uses),
+    so a benchmark run from a fresh clone after ``make setup`` finds what the tests found."""
+    if os.environ.get("SAILOR_DARKNET_DATA"):
+        return Path(os.environ["SAILOR_DARKNET_DATA"])
+    system = Path("/usr/share/darknet/data")
+    if (system / "dog.jpg").is_file() or not (CHECKOUT_PHOTOS / "dog.jpg").is_file():
+        return system
+    return CHECKOUT_PHOTOS
+
+
+def require_photos() -> Path:
+    """The photo folder, or a clear error saying how to get the photos (without them the detector
+    finds nothing in the benchmark's frames and every figure would be empty)."""
+    folder = photo_folder()
+    if not any((folder / f"{name}.jpg").is_file() for name in PHOTO_NAMES):
+        raise NoPhotosError(
+            f"no darknet photos in {folder}: the detector benchmark shows real photos for the detector to find. "
+            "Run scripts/fetch_test_data.sh (it unpacks them into build/test-data/) or set SAILOR_DARKNET_DATA "
+            "to a folder holding dog.jpg, horses.jpg, person.jpg, ...")
+    return folder
 
 
 def load_object_photos(count: int) -> list[np.ndarray]:
     """Up to ``count`` photos of single objects (RGB): the objects the SSD detector finds with a score
-    of 0.7 or more in the darknet photos of ``SAILOR_DARKNET_DATA``, each cut out with a margin, so
+    of 0.7 or more in the darknet photos (:func:`photo_folder`), each cut out with a margin, so
     that each of the scene's objects is one the detector can find again (a whole photo shrunk into
     a scene's cell holds objects too small for it). None where the photos are missing."""
     import cv2
 
     from merlin2_sailor.perception.detector_registry import create_detector
 
-    folder = Path(os.environ.get("SAILOR_DARKNET_DATA") or "/usr/share/darknet/data")
+    folder = photo_folder()
     images = [cv2.imread(str(folder / f"{name}.jpg")) for name in PHOTO_NAMES]
     photos = [cv2.cvtColor(image, cv2.COLOR_BGR2RGB) for image in images if image is not None]
     if not photos:

@@ -9,11 +9,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from harness.machine import summary
 from harness.results import BenchmarkResult, json_safe
+
+
+class CannotRun(RuntimeError):
+    """What a benchmark needs is missing (its message says how to get it): one line, exit code 2."""
 
 
 def parser(description: str) -> argparse.ArgumentParser:
@@ -39,7 +44,11 @@ def main(
     arguments = vars(arguments_parser.parse_args(argv))
     json_path = arguments.pop("json")
     print(f"machine: {summary()}", flush=True)
-    result = run(**arguments)
+    try:
+        result = run(**arguments)
+    except CannotRun as error:
+        print(f"cannot run: {error}", file=sys.stderr, flush=True)
+        return 2
     print(result.text(), flush=True)
     if json_path is not None:
         json_path.parent.mkdir(parents=True, exist_ok=True)

@@ -15,6 +15,7 @@ from pathlib import Path
 from types import ModuleType
 
 import cv2
+import numpy as np
 import pytest
 
 from merlin2_sailor.cli.bench import bench_directory
@@ -117,3 +118,30 @@ def test_a_failing_benchmark_is_reported_and_the_others_still_run(tmp_path, monk
     report = (output / "report.md").read_text()
     assert "## knowledge_sync: failed" in report and "this benchmark is broken" in report
     assert "FAILED: knowledge_sync" in capsys.readouterr().out
+
+
+def test_the_detector_benchmarks_find_the_photos_the_tests_use_and_refuse_in_one_line_without_them(
+        suite: ModuleType, monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    from harness import scene, script
+
+    photos = tmp_path / "darknet"
+    photos.mkdir()
+    cv2.imwrite(str(photos / "dog.jpg"), np.zeros((8, 8, 3), np.uint8))
+    monkeypatch.setenv("SAILOR_DARKNET_DATA", str(photos))
+    assert scene.photo_folder() == photos and scene.require_photos() == photos
+    # Unset, a checkout's copy from scripts/fetch_test_data.sh is found when the system has none.
+    monkeypatch.delenv("SAILOR_DARKNET_DATA")
+    monkeypatch.setattr(scene, "CHECKOUT_PHOTOS", photos)
+    assert scene.photo_folder() in (photos, Path("/usr/share/darknet/data"))
+    if not Path("/usr/share/darknet/data/dog.jpg").is_file():
+        assert scene.photo_folder() == photos
+
+    monkeypatch.setenv("SAILOR_DARKNET_DATA", str(tmp_path / "nowhere"))
+
+    def run(quick: bool) -> None:
+        scene.require_photos()
+
+    assert script.main(run, "a benchmark that needs photos", argv=["--quick"]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith("cannot run: no darknet photos in ") and "scripts/fetch_test_data.sh" in error
+    assert "Traceback" not in error
