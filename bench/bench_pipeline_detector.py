@@ -90,10 +90,8 @@ def first_received_ms(recording: Recording, phase_index: int, outputs: list[tupl
 def stage_row(recording: Recording, phase_index: int, stats) -> list:
     """Where a frame's time goes: p50 / p95 from the image stamp to each stage's output reaching the probe."""
     detections = first_received_ms(recording, phase_index, recording.detections)
-    percepts = [(received, stamp) for received, stamp, _ in recording.percepts]
-    percepts = first_received_ms(recording, phase_index, percepts)
     cells = []
-    for latencies in (detections, percepts, stats.latencies_ms):
+    for latencies in (detections, stats.percept_latencies_ms, stats.latencies_ms):
         cells.append(f"{np.percentile(latencies, 50):.0f} / {np.percentile(latencies, 95):.0f}" if latencies else "-")
     return cells
 

@@ -24,6 +24,7 @@ from merlin2_sailor.contract.camera import CameraIntrinsics
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.contract.pose import Pose
 from merlin2_sailor.perception.detection import Detection
+from merlin2_sailor.training.photo_library import DARKNET_ENVIRONMENT_VARIABLE, DEFAULT_DARKNET_FOLDER
 
 WIDTH, HEIGHT = 640, 480
 WALL_MILLIMETRES = 5000
@@ -112,9 +113,9 @@ def photo_folder() -> Path:
     """The darknet photo folder: ``SAILOR_DARKNET_DATA`` when set, else the system's package, else
     the copy ``scripts/fetch_test_data.sh`` unpacked into this checkout (the one ``make test`` uses),
     so a benchmark run from a fresh clone after ``make setup`` finds what the tests found."""
-    if os.environ.get("SAILOR_DARKNET_DATA"):
-        return Path(os.environ["SAILOR_DARKNET_DATA"])
-    system = Path("/usr/share/darknet/data")
+    if os.environ.get(DARKNET_ENVIRONMENT_VARIABLE):
+        return Path(os.environ[DARKNET_ENVIRONMENT_VARIABLE])
+    system = Path(DEFAULT_DARKNET_FOLDER)
     if (system / "dog.jpg").is_file() or not (CHECKOUT_PHOTOS / "dog.jpg").is_file():
         return system
     return CHECKOUT_PHOTOS
@@ -127,8 +128,8 @@ def require_photos() -> Path:
     if not any((folder / f"{name}.jpg").is_file() for name in PHOTO_NAMES):
         raise NoPhotosError(
             f"no darknet photos in {folder}: the detector benchmark shows real photos for the detector to find. "
-            "Run scripts/fetch_test_data.sh (it unpacks them into build/test-data/) or set SAILOR_DARKNET_DATA "
-            "to a folder holding dog.jpg, horses.jpg, person.jpg, ...")
+            "Run scripts/fetch_test_data.sh (it unpacks them into build/test-data/) or set "
+            f"{DARKNET_ENVIRONMENT_VARIABLE} to a folder holding dog.jpg, horses.jpg, person.jpg, ...")
     return folder
 
 

@@ -27,13 +27,17 @@ def symbols_before_change(
     """True object id -> the symbol that named it once the robot had looked around (see the module)."""
     confirmed = [anchor for anchor in anchors if anchor.state == "confirmed"]
     missing = [anchor for anchor in anchors if anchor.state in CLAIMING_STATES and anchor.state != "confirmed"]
-    named = associate(initial_truth, confirmed)
-    unnamed = [obj for obj in initial_truth if obj.id not in named]
-    named.update(associate(unnamed, missing))
+    named = _confirmed_first(initial_truth, confirmed, missing)
     if target_now is not None and target_now.id not in named:
         taken = set(named.values())
-        free_confirmed = [anchor for anchor in confirmed if anchor.symbol not in taken]
-        named.update(associate([target_now], free_confirmed))
-        if target_now.id not in named:
-            named.update(associate([target_now], [anchor for anchor in missing if anchor.symbol not in taken]))
+        named.update(_confirmed_first([target_now], [a for a in confirmed if a.symbol not in taken],
+                                      [a for a in missing if a.symbol not in taken]))
+    return named
+
+
+def _confirmed_first(objects: Sequence[TrueObject], confirmed: Sequence[AnchorRecord],
+                     missing: Sequence[AnchorRecord]) -> dict[str, str]:
+    """Objects named by confirmed anchors, then the rest by missing ones."""
+    named = associate(objects, confirmed)
+    named.update(associate([obj for obj in objects if obj.id not in named], missing))
     return named
