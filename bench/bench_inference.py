@@ -80,10 +80,12 @@ def frame_pairs(count: int, dimension: int) -> PairFeatures:
     """``count`` same-class pairs with appearance, features in their usual ranges (what one frame scores)."""
     rng = np.random.default_rng(count)
     distance, elapsed = rng.uniform(0.0, 3.0, count), rng.uniform(0.0, 60.0, count)
+    widths_apart = distance / rng.uniform(0.05, 1.5, count)
     difference = np.abs(rng.normal(0.0, 0.5, (count, dimension))).astype(np.float32)
     return PairFeatures(
         rows=np.arange(count), columns=np.arange(count), same_class=np.ones(count, dtype=bool), distance=distance,
-        footprint_distance=distance, distance_score=np.exp(-distance), scale=rng.uniform(0.7, 1.4, count),
+        footprint_distance=distance, distance_score=np.exp(-distance), separation=widths_apart,
+        separation_score=np.exp(-widths_apart), scale=rng.uniform(0.7, 1.4, count),
         time_difference=elapsed, time_score=np.exp(-elapsed / 30.0), searched=np.zeros(count, dtype=bool),
         appearance_known=np.ones(count, dtype=bool), appearance_distance=difference.sum(axis=1),
         appearance_difference=difference)

@@ -12,7 +12,8 @@ and surround, see :mod:`merlin2_sailor.perception.colour_histogram`; S, B, C1 an
   are unchanged): a few hundred objects' views are learnt by heart otherwise, and the held-out
   pairs suffer;
 - PerceptAnchor network: one Linear(., B) + ReLU per feature (same class, siamese output,
-  distance, scale, time; searched: whether the distance was measured from a searched disc, see
+  distance (two values: metres and object widths apart, see :mod:`.features`), scale,
+  time; searched: whether the distance was measured from a searched disc, see
   :mod:`.features`; colour: the intersections of the two crops' centre and surround histograms (2
   values), from the last K values of the same ``|f_p - f_a|``), concatenated (7 x B) -> Linear(7 B, B) -> ReLU;
 - binary classifier: Dropout(0.5) -> Linear(B, C1) -> ReLU -> Linear(C1, C2) -> ReLU ->
@@ -46,6 +47,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.features import FEATURE_ENCODING_VERSION, PairFeatures
 from merlin2_sailor.anchoring.network_inputs import (
+    DISTANCE_VALUES,
     NetworkMatcherConfig,
     NetworkMetadata,
     PairNetworkMatcher,
@@ -81,7 +83,7 @@ class MatchingNetwork(nn.Module):
         self.siamese = _dense(self.metadata.backbone_dimension, self.metadata.siamese_units)
         self.same_class_branch = _dense(1, units)
         self.siamese_branch = _dense(self.metadata.siamese_units, units)
-        self.distance_branch = _dense(1, units)
+        self.distance_branch = _dense(DISTANCE_VALUES, units)
         self.scale_branch = _dense(1, units)
         self.time_branch = _dense(1, units)
         self.search_branch = _dense(1, units)
@@ -106,14 +108,15 @@ class MatchingNetwork(nn.Module):
         colour: torch.Tensor,
     ) -> torch.Tensor:
         """Return (N,) logits. Scalars are (N,) or (N, 1) encoded features, the difference (N, D)
-        of the backbone's features only, ``colour`` (N, 2) (see :meth:`inputs_from`)."""
+        of the backbone's features only, ``distance`` (N, 2) (its score and the separation's),
+        ``colour`` (N, 2) (see :meth:`inputs_from`)."""
         if self.metadata.appearance_dropout and self.training:
             appearance_difference = nn.functional.dropout(appearance_difference, self.metadata.appearance_dropout)
         merged = torch.cat(
             (
                 self.same_class_branch(same_class.reshape(-1, 1)),
                 self.siamese_branch(self.siamese(appearance_difference)),
-                self.distance_branch(distance.reshape(-1, 1)),
+                self.distance_branch(distance.reshape(-1, DISTANCE_VALUES)),
                 self.scale_branch(scale.reshape(-1, 1)),
                 self.time_branch(time.reshape(-1, 1)),
                 self.search_branch(searched.reshape(-1, 1)),

@@ -22,6 +22,9 @@ from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, C
 
 #: The network's inputs in the order of its forward pass (also the exported model's input names).
 INPUT_NAMES = ("same_class", "appearance_difference", "distance", "scale", "time", "searched", "colour")
+#: Values of the distance input per pair: the distance score and the separation score (see
+#: :mod:`.features`), read by one branch, as the paper's distance is.
+DISTANCE_VALUES = 2
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,7 +76,7 @@ class NetworkMetadata:
 def network_inputs(metadata: NetworkMetadata, features: PairFeatures) -> tuple[np.ndarray, ...]:
     """The network's float32 inputs for every pair of ``features`` (appearance rows must be known),
     in :data:`INPUT_NAMES` order: the embedding difference is split into the backbone's part and
-    the colour similarity of the two crops' descriptors."""
+    the colour similarity of the two crops' descriptors; the distance is (N, :data:`DISTANCE_VALUES`)."""
     if features.appearance_difference is None:
         raise SailorError("The matching network needs appearance; compute features with with_appearance=True.")
     if features.appearance_difference.shape[1] != metadata.feature_dimension:
@@ -93,7 +96,7 @@ def network_inputs(metadata: NetworkMetadata, features: PairFeatures) -> tuple[n
     return (
         column(features.same_class),
         column(difference[:, :backbone]),
-        column(features.distance_score),
+        column(np.stack((features.distance_score, features.separation_score), axis=1)),
         column(features.scale),
         column(features.time_score),
         column(features.searched),

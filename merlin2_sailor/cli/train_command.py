@@ -45,7 +45,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="training scenes (default 32 houses, 120 generated scenes)")
     parser.add_argument("--validation-scenes", type=int, default=None, metavar="N",
                         help="validation scenes (default 8 houses, 16 generated scenes)")
-    parser.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainingConfig's, 3)")
+    parser.add_argument("--epochs", type=int, default=None, help="epochs (default: TrainingConfig's, 10)")
     parser.add_argument("--batch-size", type=int, default=256, help="pairs per batch (default 256)")
     parser.add_argument("--learning-rate", type=float, default=0.001,
                         help="Adam learning rate (default 0.001, the paper's)")

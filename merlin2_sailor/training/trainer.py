@@ -34,7 +34,10 @@ from merlin2_sailor.training.progress import progress_bar
 
 @dataclass(frozen=True, slots=True)
 class TrainingConfig:
-    """``device``: "auto" (CUDA when available, else CPU), "cpu" or "cuda";
+    """``epochs``: passes over the training pairs, the best by validation F1 kept: with 3 (the
+    default until 4 December 2026) the validation F1 was still rising at the last epoch (0.922);
+    over 10, with the cosine decay stretched over them, the best was epoch 4 (0.934);
+    ``device``: "auto" (CUDA when available, else CPU), "cpu" or "cuda";
     ``shuffle_buffer_pairs``: how many pairs are mixed before batches are drawn;
     ``learning_rate``: Adam's (the paper's 0.001) in the first epoch, lowered along a cosine to
     ``final_learning_rate`` in the last: with the paper's constant rate the validation F1 of the
@@ -50,7 +53,7 @@ class TrainingConfig:
     of the demo's house scored over 0.9 against the red one, with 1 the red mug itself only 0.62
     against its own anchor seen from afar; with 2, 0.87 against 0.66 for the green mug."""
 
-    epochs: int = 3
+    epochs: int = 10
     batch_size: int = 256
     learning_rate: float = 0.001
     final_learning_rate: float = 1e-5

@@ -152,3 +152,32 @@ def test_the_distance_score_forgives_what_a_large_objects_extent_explains():
     mug = pair_features(*_columns_at(0.3, (0.1, 0.1, 0.1)), [0], [0], FeatureConfig(), False)
     assert mug.footprint_distance[0] == pytest.approx(0.3)
     assert mug.distance_score[0] == pytest.approx(math.exp(-0.3))
+
+
+def test_the_separation_counts_widths_along_the_line_between_the_centres():
+    # Books stand thin side along a shelf: 0.2 m along the row is four of a 5 cm book's widths (a
+    # neighbour), 0.2 m across it one of its 20 cm depth; a 1 m television 0.2 m off is a fifth.
+    along_row = pair_features(*_columns_at(0.2, (0.05, 0.2, 0.25)), [0], [0], FeatureConfig(), False)
+    assert along_row.separation[0] == pytest.approx(4.0)
+    assert along_row.separation_score[0] == pytest.approx(math.exp(-4.0))
+    across = pair_features(*_columns_at(0.2, (0.2, 0.05, 0.25)), [0], [0], FeatureConfig(), False)
+    assert across.separation[0] == pytest.approx(1.0)
+    tv = pair_features(*_columns_at(0.2, (1.0, 0.1, 0.6)), [0], [0], FeatureConfig(), False)
+    assert tv.separation[0] == pytest.approx(0.2)
+    same_place = pair_features(*_columns_at(0.0, (0.05, 0.2, 0.25)), [0], [0], FeatureConfig(), False)
+    assert same_place.separation[0] == 0.0 and same_place.separation_score[0] == 1.0
+
+
+def test_the_separation_is_measured_in_the_wider_box_and_never_in_a_sliver():
+    from merlin2_sailor.anchoring.features import MINIMUM_SEPARATION_WIDTH, separation
+
+    # A partial view (half the television) is measured in the whole's width, not its own.
+    offsets = np.array([[0.3, 0.0, 0.0], [0.3, 0.0, 0.0], [0.0, 0.0, 0.4], [0.1, 0.1, 0.0]])
+    distances = np.linalg.norm(offsets, axis=1)
+    percept_sizes = np.array([[0.5, 0.1, 0.6], [0.001, 0.001, 0.1], [0.3, 0.1, 0.1], [0.2, 0.2, 0.2]])
+    anchor_sizes = np.array([[1.0, 0.1, 0.6], [0.002, 0.0, 0.1], [0.1, 0.2, 0.1], [0.2, 0.2, 0.2]])
+    widths = separation(offsets, distances, percept_sizes, anchor_sizes)
+    assert widths[0] == pytest.approx(0.3)
+    assert widths[1] == pytest.approx(0.3 / MINIMUM_SEPARATION_WIDTH)
+    assert widths[2] == pytest.approx(0.4 / 0.3)  # straight above: the longest horizontal side
+    assert widths[3] == pytest.approx(math.hypot(0.1, 0.1) / (0.2 * math.sqrt(2.0)))  # diagonal of a square box

@@ -47,13 +47,13 @@ COLOUR_BINS = 42  # a colour descriptor: the histograms of a crop's centre and s
 
 
 def random_inputs(count: int, dimension: int = DIMENSION):
-    """Forward's inputs: same class, the backbone part of the difference, distance, scale, time,
-    searched, colour similarity."""
+    """Forward's inputs: same class, the backbone part of the difference, distance (metres and
+    widths apart), scale, time, searched, colour similarity."""
     generator = torch.Generator().manual_seed(1)
     return (
         torch.randint(0, 2, (count,), generator=generator).float(),
         torch.rand(count, dimension, generator=generator),
-        torch.rand(count, generator=generator),
+        torch.rand(count, 2, generator=generator),
         torch.rand(count, generator=generator),
         torch.rand(count, generator=generator),
         torch.randint(0, 2, (count,), generator=generator).float(),
@@ -66,9 +66,9 @@ def test_architecture_has_the_published_structure_with_the_default_sizes():
     assert network.metadata.feature_dimension == 1280 + 42 and network.metadata.colour_bins == 42
     assert network.siamese[0].in_features == 1280 and network.siamese[0].out_features == 256
     assert network.siamese_branch[0].in_features == 256 and network.siamese_branch[0].out_features == 64
-    for branch in (network.same_class_branch, network.distance_branch, network.scale_branch, network.time_branch,
-                   network.search_branch):
+    for branch in (network.same_class_branch, network.scale_branch, network.time_branch, network.search_branch):
         assert (branch[0].in_features, branch[0].out_features) == (1, 64)
+    assert (network.distance_branch[0].in_features, network.distance_branch[0].out_features) == (2, 64)
     assert (network.colour_branch[0].in_features, network.colour_branch[0].out_features) == (2, 64)
     assert network.merge[0].in_features == 7 * 64 and network.merge[0].out_features == 64
     layers = [m for m in network.classifier if isinstance(m, torch.nn.Linear)]
@@ -110,10 +110,12 @@ def test_network_is_trainable(network):
     assert losses[-1] < 0.5 * losses[0]
 
 
-def test_the_network_can_learn_what_only_colour_tells(network):
+@pytest.mark.parametrize(("input_index", "column", "what"), [(6, 1, "the surround's colour similarity"),
+                                                              (2, 1, "the separation in object widths")])
+def test_the_network_can_learn_what_only_one_input_value_tells(network, input_index, column, what):
     network.train()
     inputs = random_inputs(128)
-    labels = (inputs[6][:, 1] > 0.5).float()  # only the surround's colour similarity decides
+    labels = (inputs[input_index][:, column] > 0.5).float()  # only this value decides
     optimiser = torch.optim.Adam(network.parameters(), lr=3e-3)
     loss_function = torch.nn.BCEWithLogitsLoss()
     for _ in range(150):

@@ -64,7 +64,9 @@ def test_the_openvino_backbone_gives_torchs_features() -> None:
 def random_pairs(count: int, dimension: int, seed: int = 0) -> PairFeatures:
     """Pairs with every feature in its real range; a quarter without appearance (the rules score those)."""
     generator = np.random.default_rng(seed)
-    distance = generator.uniform(0.0, 3.0, count)
+    near = generator.random(count) < 0.5  # half of them where an anchor's own views fall
+    distance = np.where(near, generator.uniform(0.0, 0.1, count), generator.uniform(0.0, 3.0, count))
+    widths_apart = distance / generator.uniform(0.1, 1.0, count)
     time_difference = generator.uniform(0.0, 120.0, count)
     known = generator.random(count) > 0.25
     difference = np.abs(generator.normal(0.0, 0.6, (count, dimension))).astype(np.float32)
@@ -73,7 +75,8 @@ def random_pairs(count: int, dimension: int, seed: int = 0) -> PairFeatures:
     return PairFeatures(
         rows=np.arange(count), columns=np.zeros(count, dtype=np.intp),
         same_class=generator.random(count) > 0.2, distance=distance, footprint_distance=distance,
-        distance_score=np.exp(-distance), scale=generator.uniform(0.5, 2.0, count),
+        distance_score=np.exp(-distance), separation=widths_apart, separation_score=np.exp(-widths_apart),
+        scale=generator.uniform(0.5, 2.0, count),
         time_difference=time_difference, time_score=np.exp(-time_difference / 30.0),
         searched=generator.random(count) > 0.8, appearance_known=known,
         appearance_distance=np.where(known, difference.sum(axis=1), np.nan), appearance_difference=difference,
