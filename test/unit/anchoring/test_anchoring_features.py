@@ -10,12 +10,14 @@ import pytest
 from merlin2_sailor.anchoring import FeatureConfig
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.features import (
+    MINIMUM_SEPARATION_WIDTH,
     AnchorColumns,
     PerceptColumns,
     encode_distance,
     encode_time,
     pair_features,
     scale_factor,
+    separation,
 )
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
@@ -155,29 +157,30 @@ def test_the_distance_score_forgives_what_a_large_objects_extent_explains():
 
 
 def test_the_separation_counts_widths_along_the_line_between_the_centres():
-    # Books stand thin side along a shelf: 0.2 m along the row is four of a 5 cm book's widths (a
-    # neighbour), 0.2 m across it one of its 20 cm depth; a 1 m television 0.2 m off is a fifth.
-    along_row = pair_features(*_columns_at(0.2, (0.05, 0.2, 0.25)), [0], [0], FeatureConfig(), False)
-    assert along_row.separation[0] == pytest.approx(4.0)
-    assert along_row.separation_score[0] == pytest.approx(math.exp(-4.0))
-    across = pair_features(*_columns_at(0.2, (0.2, 0.05, 0.25)), [0], [0], FeatureConfig(), False)
-    assert across.separation[0] == pytest.approx(1.0)
+    # Two boxes 0.4 m apart along x: two of a 20 x 60 cm box's widths, two thirds of its width
+    # turned; a 1 m television 0.2 m off is a fifth of its width.
+    along_narrow_side = pair_features(*_columns_at(0.4, (0.2, 0.6, 0.25)), [0], [0], FeatureConfig(), False)
+    assert along_narrow_side.separation[0] == pytest.approx(2.0)
+    assert along_narrow_side.separation_score[0] == pytest.approx(math.exp(-2.0))
+    along_wide_side = pair_features(*_columns_at(0.4, (0.6, 0.2, 0.25)), [0], [0], FeatureConfig(), False)
+    assert along_wide_side.separation[0] == pytest.approx(0.4 / 0.6)
+    # A 5 cm book is measured in the floor's width (depth noise and pose error do not shrink with it).
+    book = pair_features(*_columns_at(0.3, (0.05, 0.2, 0.25)), [0], [0], FeatureConfig(), False)
+    assert book.separation[0] == pytest.approx(0.3 / MINIMUM_SEPARATION_WIDTH)
     tv = pair_features(*_columns_at(0.2, (1.0, 0.1, 0.6)), [0], [0], FeatureConfig(), False)
     assert tv.separation[0] == pytest.approx(0.2)
-    same_place = pair_features(*_columns_at(0.0, (0.05, 0.2, 0.25)), [0], [0], FeatureConfig(), False)
+    same_place = pair_features(*_columns_at(0.0, (0.2, 0.6, 0.25)), [0], [0], FeatureConfig(), False)
     assert same_place.separation[0] == 0.0 and same_place.separation_score[0] == 1.0
 
 
 def test_the_separation_is_measured_in_the_wider_box_and_never_in_a_sliver():
-    from merlin2_sailor.anchoring.features import MINIMUM_SEPARATION_WIDTH, separation
-
     # A partial view (half the television) is measured in the whole's width, not its own.
     offsets = np.array([[0.3, 0.0, 0.0], [0.3, 0.0, 0.0], [0.0, 0.0, 0.4], [0.1, 0.1, 0.0]])
     distances = np.linalg.norm(offsets, axis=1)
-    percept_sizes = np.array([[0.5, 0.1, 0.6], [0.001, 0.001, 0.1], [0.3, 0.1, 0.1], [0.2, 0.2, 0.2]])
-    anchor_sizes = np.array([[1.0, 0.1, 0.6], [0.002, 0.0, 0.1], [0.1, 0.2, 0.1], [0.2, 0.2, 0.2]])
+    percept_sizes = np.array([[0.5, 0.1, 0.6], [0.001, 0.001, 0.1], [0.3, 0.1, 0.1], [0.3, 0.3, 0.2]])
+    anchor_sizes = np.array([[1.0, 0.1, 0.6], [0.002, 0.0, 0.1], [0.1, 0.2, 0.1], [0.3, 0.3, 0.2]])
     widths = separation(offsets, distances, percept_sizes, anchor_sizes)
     assert widths[0] == pytest.approx(0.3)
     assert widths[1] == pytest.approx(0.3 / MINIMUM_SEPARATION_WIDTH)
     assert widths[2] == pytest.approx(0.4 / 0.3)  # straight above: the longest horizontal side
-    assert widths[3] == pytest.approx(math.hypot(0.1, 0.1) / (0.2 * math.sqrt(2.0)))  # diagonal of a square box
+    assert widths[3] == pytest.approx(math.hypot(0.1, 0.1) / (0.3 * math.sqrt(2.0)))  # diagonal of a square box
