@@ -47,8 +47,12 @@ def identity_scores(
     if not candidates:
         return np.zeros(0)
     # A candidate that knows only a part of a large lost object (a view end-on, through a door)
-    # is compared without its look, as a partial percept is (matching_table.comparable_views).
-    comparable = comparable_views(np.array([anchor.size for anchor in candidates]), None, [lost])[:, 0]
+    # is compared without its look, as a partial percept is (matching_table.comparable_views);
+    # so is a lost anchor that knew only a part of what the candidate shows whole (a bicycle's
+    # end anchored first, the whole bicycle later: scenario suite, 4 December, a duplicate).
+    sizes = np.array([anchor.size for anchor in candidates])
+    comparable = (comparable_views(sizes, None, [lost])[:, 0]
+                  & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0])
     percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
     anchors = AnchorColumns.from_anchors([lost])
     if disc is None:

@@ -203,6 +203,24 @@ def test_an_anchor_knowing_only_part_of_a_lost_large_object_is_compared_without_
     assert told_apart < 0.5 * identity_scores(RuleMatcher(), [other_look], lost)[0]
 
 
+def test_a_lost_anchor_that_knew_only_part_of_a_large_object_is_compared_without_its_look(maker) -> None:
+    """The mirror case: the bicycle's end was anchored first (its only views end-on), the whole
+    bicycle later under a second symbol; once the first is lost, the whole one is judged against
+    it by class, place and time, not by how little a bicycle's end looks like a bicycle."""
+    fusion = AnchoringConfig().fusion
+    end_on = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX, size=(0.13, 0.46, 1.0)),
+                                 looks(maker, "a bicycle's near end"), fusion)
+    whole = Anchor.from_percept("bicycle_2", view_of(maker, BICYCLE, 5.0, MIDDLE_BOX), looks(maker, "bicycle"), fusion)
+    by_rules = identity_scores(RuleMatcher(), [whole], end_on)
+    assert by_rules[0] > 0.5
+    np.testing.assert_allclose(identity_scores(AppearanceRules(), [whole], end_on), by_rules)
+    # Two anchors of the same extent are still told apart by their look.
+    other = Anchor.from_percept("bicycle_3", view_of(maker, BICYCLE, 5.0, MIDDLE_BOX), looks(maker, "a trolley"),
+                                fusion)
+    [told_apart] = identity_scores(AppearanceRules(), [other], whole)
+    assert told_apart < 0.5 * identity_scores(RuleMatcher(), [other], whole)[0]
+
+
 def test_a_caller_that_knows_which_views_are_cut_says_so_without_a_camera(maker) -> None:
     """A replay of rendered scenes has no camera image to tell a cut view by, but its renderer knows
     which views are cut: told so, the core scores such a view without its look, as the node does
