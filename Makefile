@@ -30,12 +30,17 @@ pipeline-demo: setup
 		echo && echo "What the robot knows now (sailor knowledge show --store sqlite://$(PIPELINE_DATA)/knowledge.db):" && \
 		$(VENV)/bin/sailor knowledge show --store sqlite://$(CURDIR)/$(PIPELINE_DATA)/knowledge.db
 
+# Two pytest workers by default (the CI machine has two cores; most of the suite waits on DDS and
+# simulated missions in real time); a module's or class's tests stay on one worker, so a stack
+# started once per module is started once. TEST_WORKERS=0 runs everything in one process.
+TEST_WORKERS ?= 2
+
 # With SAILOR_UPSTREAM=path/to/sources (the layout of ../shared/upstream: KANT, YASMIN, MERLIN2...),
 # the tests against the real MERLIN2 stack run too (scripts/upstream_env.sh builds it once), and the
 # behaviour suite runs a second time, on the real YASMIN instead of the project's own subset.
 test: setup
 	@upstream_env="$$(scripts/upstream_env.sh)" && . "$$upstream_env" && \
-		SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest && \
+		SAILOR_DARKNET_DATA=$$(scripts/fetch_test_data.sh) $(VENV)/bin/python -m pytest -n $(TEST_WORKERS) --dist loadscope --durations=15 && \
 		if [ -n "$${SAILOR_UPSTREAM:-}" ]; then \
 			echo "The behaviour suite again, on the real YASMIN from $$SAILOR_UPSTREAM:"; \
 			SAILOR_STATE_MACHINES=real $(VENV)/bin/python -m pytest test/unit/behaviors; \

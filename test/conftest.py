@@ -27,7 +27,19 @@ from merlin2_sailor.inference.model_cache import cache_folder
 REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
 
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+
+
+def _worker_index() -> int | None:
+    """This process's pytest-xdist worker number (``make test`` runs two), None outside one."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+    return int(worker[2:]) if worker.startswith("gw") and worker[2:].isdigit() else None
+
+
+# One ROS domain per run, and one per worker within it: the workers inherit the controller's
+# domain (set when it loaded this file) and step off it, so two runs, or two workers, never meet.
 os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+if _worker_index() is not None:
+    os.environ["ROS_DOMAIN_ID"] = str(1 + (int(os.environ["ROS_DOMAIN_ID"]) - 1 + _worker_index() + 1) % 101)
 os.environ.setdefault("ROS_LOG_DIR", tempfile.mkdtemp(prefix="sailor-test-ros-logs-"))
 os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "config" / "fastdds.xml"))
 os.environ.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
@@ -71,8 +83,9 @@ def upstream_stack() -> Callable[..., None]:
 
 
 KANT_NODE_MODULE = "kant_knowledge_base.knowledge_base_node_main"
-KANT_START_SECONDS = 30.0
 """KANT's knowledge-base node, MERLIN2's knowledge base, as ``ros2 run kant_knowledge_base`` starts it."""
+KANT_START_SECONDS = 30.0
+KANT_STOP_SECONDS = 3.0
 
 
 @dataclass
@@ -108,7 +121,8 @@ def start_kant_node(upstream_stack) -> Iterator[Callable[[str], KantNode]]:
     for process in started:
         process.send_signal(signal.SIGINT)  # what ros2 launch sends; KANT's node ignores SIGTERM
         try:
-            process.wait(timeout=10)
+            # Most stop within a second; one in five outlives SIGINT for good (measured: 10 s each).
+            process.wait(timeout=KANT_STOP_SECONDS)
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()

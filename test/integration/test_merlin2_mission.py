@@ -44,6 +44,8 @@ GROUNDING_FILE = WORLDS / "small_house_grounding.yaml"
 KANT = "kant+ros:///merlin2"
 START_SECONDS = 90.0
 MISSION_SECONDS = 240.0
+STOP_SECONDS = 15.0
+"""How long the stack has to stop on SIGINT before what is left is killed."""
 SIGHT_RANGE = 4.5
 """Metres: the percept generator's maximum depth here (beyond it nothing is placed)."""
 ACTIONS = ("navigation", "explore", "find_object")
@@ -63,10 +65,17 @@ class Process:
     log: Path
 
     def stop(self, timeout: float = 20.0) -> int:
+        self.interrupt()
+        return self.wait_or_kill(time.monotonic() + timeout)
+
+    def interrupt(self) -> None:
+        """SIGINT, as ``ros2 launch`` sends it."""
         if self.popen.poll() is None:
             self.popen.send_signal(signal.SIGINT)
+
+    def wait_or_kill(self, deadline: float) -> int:
         try:
-            return self.popen.wait(timeout)
+            return self.popen.wait(max(deadline - time.monotonic(), 0.0))
         except subprocess.TimeoutExpired:
             self.popen.kill()
             return self.popen.wait()
@@ -173,8 +182,13 @@ def house(tmp_path_factory: pytest.TempPathFactory, upstream_stack: Callable[...
             f"[{name}] {process.text[-1500:]}" for name, process in processes.items())
         yield Merlin2House(folder, start, processes)
     finally:
+        # All at once, under one deadline: some of MERLIN2's nodes outlive SIGINT, and stopped one
+        # after another they cost the suite their timeouts in sum (45 s measured).
         for name in reversed(list(processes)):
-            processes[name].stop()
+            processes[name].interrupt()
+        deadline = time.monotonic() + STOP_SECONDS
+        for name in reversed(list(processes)):
+            processes[name].wait_or_kill(deadline)
 
 
 def mug_symbol(house: Merlin2House) -> str:
