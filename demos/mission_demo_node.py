@@ -157,6 +157,7 @@ class MissionDemoNode(Node):
         self._symbols_before: dict[str, str] = {}
         self._timeline = TruthTimeline()
         self._ambiguous: list[dict[str, Any]] = []  # the anchoring layer's "cannot tell apart" events
+        self._acquired_because: dict[str, str] = {}  # symbol -> its acquired event's nearest_anchor
         self._awaited: set[str] = set()  # the world's events a route stop has waited for
         self._grounding = Grounding(GroundingConfig.from_yaml(grounding_file))
         self._store = open_knowledge_base("ros:///merlin2")
@@ -314,7 +315,7 @@ class MissionDemoNode(Node):
         card, verdict = write_report(
             self._folder, truth, anchors, [tuple(f) for f in facts], self._place_of, self._layers(), self._history,
             f"{domain_from_store(self._store)}\n\n{problem_from_store(self._store)}", self._account, outcome,
-            claims)
+            claims, acquired_because=self._acquired_because_now())
         self._say(f"report written to {self._folder}: summary.md, scorecard.json, map.png, "
                   f"{self._frames} frames, knowledge.pddl")
         for line in card.to_markdown().splitlines():
@@ -323,6 +324,10 @@ class MissionDemoNode(Node):
         self._say(f"claims against the ground truth: {verdict.outcome}, {'right' if verdict.right else 'WRONG'}"
                   + (f" ({'; '.join(verdict.problems)})" if verdict.problems else ""))
         return verdict.right if self._judged else outcome.succeeded
+
+    def _acquired_because_now(self) -> dict[str, str]:
+        with self._lock:
+            return dict(self._acquired_because)
 
     def _claims(self, symbol: str, target: TrueObject | None, views: list, facts: list, fetch: MissionResult | None,
                 why: str) -> dict[str, Any]:
@@ -392,6 +397,11 @@ class MissionDemoNode(Node):
         for line in anchor_event_lines(self._words, message):
             self._say(line)
         for event in message.events:
+            if event.kind == AnchorEvent.KIND_ACQUIRED:
+                # Why it was not taken for an anchor already there: a duplicate's first question.
+                nearest = next((item.value for item in event.details if item.key == "nearest_anchor"), "")
+                with self._lock:
+                    self._acquired_because[event.symbol] = nearest
             if event.kind == AnchorEvent.KIND_AMBIGUOUS:
                 with self._lock:
                     self._ambiguous.append({"symbol": event.symbol, "stamp": _stamp(event),

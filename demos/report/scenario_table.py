@@ -49,9 +49,11 @@ class ScenarioRun:
     def progress_line(self, index: int, total: int) -> str:
         """The one line printed when the run ends."""
         why = self.note if self.verdict is None else "; ".join(self.verdict.problems)
+        duplicates = () if self.verdict is None else self.verdict.duplicate_origins
         return (f"[{index}/{total}] {self.scenario} seed {self.seed} {self.matcher}: "
                 f"{'RIGHT' if self.right else 'WRONG'} ({self.outcome}) in {self.wall_seconds:.0f} s"
-                + (f": {why}" if why else ""))
+                + (f": {why}" if why else "")
+                + (f" [duplicate {'; '.join(duplicates)}]" if duplicates else ""))
 
 
 COLUMNS = ("scenario", "seed", "matcher", "outcome", "right/wrong", "duplicates", "identity switches", "time (s)",
@@ -75,6 +77,10 @@ def to_markdown(runs: Sequence[ScenarioRun]) -> str:
     lines += ["", f"{right} of {len(runs)} runs right; "
               f"{sum(run.verdict.duplicates for run in runs if run.verdict)} duplicate anchor(s), "
               f"{sum(run.verdict.identity_switches for run in runs if run.verdict)} identity switch(es) in all."]
+    origins = [(run, origin) for run in runs if run.verdict for origin in run.verdict.duplicate_origins]
+    if origins:
+        lines += ["", "Duplicate anchors, and why the anchoring node made each one (its acquired event):", ""]
+        lines += [f"- {run.scenario} seed {run.seed} {run.matcher}: {origin}" for run, origin in origins]
     return "\n".join(lines) + "\n"
 
 

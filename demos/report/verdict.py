@@ -51,11 +51,15 @@ class Verdict:
     seconds: float = 0.0
     claimed: str | None = None
     """The object the target's symbol refers to at the end (None: none)."""
+    duplicate_origins: tuple[str, ...] = ()
+    """Each duplicate anchor and where it came from: why it, and the anchor of the object it stands
+    beside, were anchored anew (the anchoring node's acquired events), a duplicate's first question."""
 
     def as_dict(self) -> dict[str, Any]:
         return {"outcome": self.outcome, "right": self.right, "problems": list(self.problems),
                 "duplicates": self.duplicates, "identity_switches": self.identity_switches,
-                "seconds": round(self.seconds, 1), "claimed": self.claimed}
+                "seconds": round(self.seconds, 1), "claimed": self.claimed,
+                "duplicate_origins": list(self.duplicate_origins)}
 
 
 @dataclass(frozen=True)
@@ -135,7 +139,15 @@ def judge(card: Mapping[str, Any], expect: Expectation | None = None) -> Verdict
         identity_switches=sum(int(n) for n in scorecard_switches.values()),
         seconds=float((card.get("outcome") or {}).get("seconds", 0.0)),
         claimed=claimed,
+        duplicate_origins=duplicate_origins(card),
     )
+
+
+def duplicate_origins(card: Mapping[str, Any]) -> tuple[str, ...]:
+    """Where each duplicate of a scorecard.json came from (:func:`.writer.explain_duplicates`); a
+    duplicate without it (a scorecard written before it was recorded) is named with "origin unknown"."""
+    origins = card.get("duplicate_origins") or {}
+    return tuple(origins.get(symbol) or f"{symbol}: origin unknown" for symbol in card.get("duplicates") or ())
 
 
 def _outcome(claims: Claims) -> str:

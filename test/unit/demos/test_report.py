@@ -151,3 +151,21 @@ def test_an_anchor_behind_a_wall_is_not_drawn_and_one_in_view_is():
     assert drawn_with(door_frame)
     without_depth = annotate_frame(frame, intrinsics, camera, [cup])
     assert np.all(without_depth[y0, x0 + 5 : x1 - 5] == (30, 90, 200))  # no depth given: drawn as before
+
+
+def test_each_duplicate_is_explained_by_why_it_and_its_neighbour_were_anchored_anew():
+    from merlin2_sailor_demos.report.writer import explain_duplicates
+
+    anchors = [
+        AnchorRecord("cup_1", "cup", (1.1, 0.0, 0.8), state="missing"),
+        AnchorRecord("cup_2", "cup", (1.0, 0.05, 0.8)),  # the nearer to mug_a: it anchors it
+        AnchorRecord("cup_3", "cup", (4.0, 0.0, 0.8)),
+        AnchorRecord("book_1", "book", (1.1, 0.0, 0.8)),  # nearest, but of another class
+    ]
+    card = score(TRUTH, anchors)
+    associated = set(associate(TRUTH, [a for a in anchors if a.state in ("confirmed", "missing")]).values())
+    assert card.duplicates == ("cup_1",) and "cup_2" in associated
+    origins = explain_duplicates(card.duplicates, anchors, associated, {"cup_2": "cup_1 ruled out by colour"})
+    assert origins == {"cup_1": "cup_1 (missing), anchored anew: no anchor of its class within the matching gate; "
+                                "beside cup_2 (confirmed, 0.11 m), anchored anew: cup_1 ruled out by colour"}
+    assert explain_duplicates((), anchors, associated, {}) == {}

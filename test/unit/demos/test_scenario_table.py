@@ -16,7 +16,7 @@ from merlin2_sailor_demos.report.verdict import Verdict
 
 RIGHT = Verdict("found as cup_1", True, (), 0, 2, 88.0, "red_mug")
 WRONG = Verdict("found as cup_1", False, ("claimed cup_1, which refers to green_mug, not the red_mug",), 1, 3, 91.0,
-                "green_mug")
+                "green_mug", ("cup_2 (confirmed), anchored anew: cup_1 ruled out by colour",))
 RUNS = [
     ScenarioRun("default", 0, "rules", RIGHT, wall_seconds=120.0),
     ScenarioRun("removed", 0, "rules", WRONG, wall_seconds=130.0),
@@ -33,13 +33,16 @@ def test_each_run_is_one_row_with_its_outcome_verdict_and_figures() -> None:
     assert lines[3].startswith("| removed | 0 | rules | found as cup_1 | WRONG | 1 | 3 | 91 | claimed cup_1")
     assert lines[4] == "| swapped | 1 | network | hang | WRONG | - | - | 420 | not done after 420 s |"
     assert lines[5].startswith("| twin_moved | 2 | network | crash | WRONG |")
-    assert lines[-1] == "1 of 4 runs right; 1 duplicate anchor(s), 5 identity switch(es) in all."
+    assert lines[7] == "1 of 4 runs right; 1 duplicate anchor(s), 5 identity switch(es) in all."
+    # Where each duplicate came from, under the table.
+    assert lines[-1] == "- removed seed 0 rules: cup_2 (confirmed), anchored anew: cup_1 ruled out by colour"
 
 
 def test_the_progress_line_says_right_or_wrong_and_why() -> None:
     assert RUNS[0].progress_line(1, 4) == "[1/4] default seed 0 rules: RIGHT (found as cup_1) in 120 s"
     assert RUNS[1].progress_line(2, 4).endswith("WRONG (found as cup_1) in 130 s: claimed cup_1, which refers to "
-                                                "green_mug, not the red_mug")
+                                                "green_mug, not the red_mug [duplicate cup_2 (confirmed), anchored "
+                                                "anew: cup_1 ruled out by colour]")
     assert "WRONG (hang)" in RUNS[2].progress_line(3, 4)
 
 

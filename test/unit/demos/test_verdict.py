@@ -148,3 +148,14 @@ def test_a_symbol_refers_to_what_its_anchor_last_saw_not_what_stands_there_now()
     assert refers_to(AnchorRecord("book_1", "book", (2.0, 2.0, 0.8)), 80.0, timeline) is None  # class counts
     assert refers_to(AnchorRecord("cup_7", "cup", (3.0, 3.0, 0.8)), 80.0, timeline) is None  # too far
     assert timeline.at(0.0) == (red, green)  # before the first version: the first
+
+
+def test_each_duplicate_comes_with_where_it_came_from_and_an_old_scorecard_says_unknown() -> None:
+    card = scorecard()
+    card["duplicates"] = ["tv_2", "dog_3"]
+    card["duplicate_origins"] = {"tv_2": "tv_2 (confirmed), anchored anew: tv_1 ruled out by colour"}
+    verdict = judge(card)
+    assert verdict.duplicates == 2
+    assert verdict.duplicate_origins == ("tv_2 (confirmed), anchored anew: tv_1 ruled out by colour",
+                                         "dog_3: origin unknown")
+    assert verdict.as_dict()["duplicate_origins"] == list(verdict.duplicate_origins)
