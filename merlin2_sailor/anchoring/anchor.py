@@ -104,6 +104,13 @@ class Anchor:
     lost_after: float | None = None
     """While MISSING: its last sighting before it went missing (later sightings while missing,
     too few to bring it back, do not count): an anchor born after it may be the object, moved."""
+    returning_since: float | None = None
+    """While MISSING: the first of the sightings now bringing it back (None: none yet)."""
+    absence: tuple[float, float] | None = None
+    """Its latest absence, from its last sighting before it went MISSING to the first sighting of
+    the run that brought it back (None: never missing and back): an anchor of its class born
+    beside it and seen only within that time may have been it, seen off its place
+    (:mod:`.stand_in`). Not persisted: it matters for seconds."""
     provenance: Provenance = Provenance.PERCEIVED
     """PERCEIVED when ``position`` comes from the camera, EXPECTED when from an action's effect."""
     perceived_position: np.ndarray = field(default_factory=_zero_vector)

@@ -57,6 +57,7 @@ from merlin2_sailor.anchoring.place_return import Return, decide_returns, note_j
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.same_space import Duplicate, decide_same_space
 from merlin2_sailor.anchoring.snapshot import anchors_of_snapshot, snapshot_of
+from merlin2_sailor.anchoring.stand_in import decide_stand_ins
 from merlin2_sailor.anchoring.symbols import SymbolCounter, SymbolFactory
 from merlin2_sailor.anchoring.unseen import check_unseen, forget_expired
 from merlin2_sailor.anchoring.visibility import CameraView, VisibilityConfig
@@ -414,6 +415,8 @@ class Anchoring:
         decisions.extend(self._repair.decide_relocations(changes.missing, judged, self._index))
         decisions.extend(decide_same_space(changes.reacquired, self._index, self.config.repair.same_space_overlap,
                                            self.config.colour, self.matcher, self.config.match_threshold))
+        decisions.extend(decide_stand_ins(changes.missing, changes.returned, self._index, repair.stand_in_distance,
+                                          self.config.colour, self.matcher, self.config.match_threshold))
         if changes.confirmed_newcomers:  # something new may be what a running search looks for
             for sought in self._index.expected():
                 if sought.expectation is not None and sought.expectation.is_search:

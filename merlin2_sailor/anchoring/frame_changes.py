@@ -43,6 +43,9 @@ class FrameChanges:
     confirmed_newcomers: list[Anchor] = field(default_factory=list)
     """Anchors confirmed for the first time in this call (identity repair reads them): not part
     of the result."""
+    returned: list[Anchor] = field(default_factory=list)
+    """MISSING anchors confirmed again in this call (identity repair reads them): not part of the
+    result."""
 
     def event(self, kind: AnchorEventKind, symbol: str, **details: Any) -> None:
         self.events.append(AnchorEvent(kind, symbol, self.stamp, details))

@@ -66,7 +66,9 @@ class RepairConfig:
     0 turns reappearance merges off); ``ambiguity_margin``: how much better than every rival a
     candidate must score to be taken (scores closer than this cannot tell the two apart);
     ``same_space_overlap``: the share of the smaller 3D box two anchors of a class must have in
-    common to be one object (:mod:`.same_space`; 0 turns that off); ``place_jump`` (m): how far from a
+    common to be one object (:mod:`.same_space`; 0 turns that off); ``stand_in_distance`` (m): how
+    close to an anchor that was away a newcomer seen only meanwhile must stand to be it, seen off its
+    place (:mod:`.stand_in`; 0 turns that off); ``place_jump`` (m): how far from a
     place an anchor must have gone, by a sudden move, for a newcomer on that place to show that the
     move went to a look-alike (:mod:`.place_return`; 0 turns that off); ``place_review`` (s): for how long after
     a jump such a newcomer is looked for."""
@@ -74,6 +76,7 @@ class RepairConfig:
     reappearance_distance: float = 0.25
     ambiguity_margin: float = 0.15
     same_space_overlap: float = 0.5
+    stand_in_distance: float = 0.25
     place_jump: float = 0.15
     place_review: float = 2.0
 
@@ -85,6 +88,11 @@ class RepairConfig:
             )
         if not (0.0 <= self.ambiguity_margin < 1.0):
             raise ConfigurationError(f"anchoring ambiguity_margin must be in [0, 1), got {self.ambiguity_margin}.")
+        if not (math.isfinite(self.stand_in_distance) and self.stand_in_distance >= 0.0):
+            raise ConfigurationError(
+                "anchoring stand_in_distance must be a non-negative number of metres (0 turns it off), "
+                f"got {self.stand_in_distance}."
+            )
         if not (math.isfinite(self.place_jump) and self.place_jump >= 0.0):
             raise ConfigurationError(
                 f"anchoring place_jump must be a non-negative number of metres (0 turns it off), got {self.place_jump}."

@@ -45,8 +45,11 @@ def apply_decision(
         duplicate.visible = False
         duplicate.state = AnchorState.FORGOTTEN
         changes.forgotten.append(duplicate)
+        evidence = {"overlap": round(decision.overlap, 2)}
+        if decision.score is not None:
+            evidence["score"] = round(decision.score, 3)
         changes.event(AnchorEventKind.FORGOTTEN, duplicate.symbol,
-                      reason=f"{decision.reason}: a second anchor of its object", overlap=round(decision.overlap, 2))
+                      reason=f"{decision.reason}: a second anchor of its object", **evidence)
         return
     if not isinstance(decision, Merge):
         involved = [anchor.symbol for anchor in (*decision.lost, *decision.found)]

@@ -70,6 +70,8 @@ def reacquire(
         changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="seen", times_seen=anchor.times_seen)
         if not was_missing:
             changes.confirmed_newcomers.append(anchor)
+        else:
+            changes.returned.append(anchor)
 
 
 def resolve_expectation(anchor: Anchor, percept: Percept, changes: FrameChanges, tolerance: float) -> None:

@@ -43,12 +43,15 @@ from merlin2_sailor.anchoring.matcher import Matcher
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Duplicate:
-    """``duplicate`` (MISSING) was a second anchor of ``kept``'s object: it is forgotten."""
+    """``duplicate`` (MISSING) was a second anchor of ``kept``'s object: it is forgotten.
+    ``overlap``: the share of the smaller 3D box the two have in common (0 where the evidence is
+    time rather than space, :mod:`.stand_in`); ``score``: the matching function's, where asked."""
 
     kept: Anchor
     duplicate: Anchor
     overlap: float
     reason: str
+    score: float | None = None
 
 
 def shared_volume(first: Anchor, second: Anchor) -> float:

@@ -359,6 +359,10 @@ SETTINGS: tuple[Setting, ...] = (
                 "Share of the smaller 3D box that a missing anchor and an anchor of its class seen in its "
                 "place must have in common to be one object (two objects cannot fill one space): the younger "
                 "is a second anchor left by a slip, and goes (0 turns it off).", 0.0, 1.0),
+        Setting("stand_in_distance", ("core", "repair", "stand_in_distance"),
+                "How close (m) to an anchor that was away a newcomer of its class, seen only while it was "
+                "away and gone as it came back, must stand to be that anchor seen off its place (a pose "
+                "error for a moment); it is forgotten and the older symbol stays (0 turns it off).", 0.0, 10.0),
         Setting("place_jump", ("core", "repair", "place_jump"),
                 "How far (m) from a place an anchor must have gone, by a sudden move (half of it in one "
                 "sighting), for a newcomer of its class seen soon after on that place to show that the move "

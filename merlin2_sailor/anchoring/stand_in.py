@@ -1,0 +1,101 @@
+"""A newcomer seen only while an older anchor was away, beside its place, was that anchor.
+
+Why. When the robot's pose estimate jumps for a moment (a turn, a localiser correction), every
+object in view is seen off its place by the error, by different amounts for different
+distances, so :mod:`.frame_registration` cannot always take it out (two objects in view, 0.15 m
+and 0.17 m off: fewer than it needs, and not one shift). The rules forgive such a view by place;
+the learned matcher, which reads how many of its widths a view stands from an anchor, rejects it
+as a neighbour: measured in `moved_and_moved_back` (network, seed 4, 4 December 2026), a cup and
+a book seen 0.16-0.17 m off for half a second became `cup_7` and `book_7`, confirmed within three
+frames (0.12 s), while `cup_4` and `book_2` went MISSING; when the pose came back, so did the old
+anchors, and the new ones went MISSING beside them, two duplicates for the rest of the run.
+Nothing else repairs that pair: the two never shared a space (a cup is narrower than the error),
+and the reappearance rules merge a newcomer into an *older* missing anchor, not the other way.
+
+What it decides. A MISSING anchor is a stand-in for an older anchor of its class (and is forgotten
+as a :class:`~.same_space.Duplicate`, the older symbol kept, as the planner knows it) when all of
+these hold:
+
+- its whole life, first to last sighting, lies inside the older anchor's latest absence (from the
+  older one's last sighting before it went MISSING to the first sighting that brought it back):
+  the two were never seen at one time, so one object may have been both;
+- it stands within ``reach`` of the older one (horizontally, plus what the larger of the two
+  objects' extents explains): where the object was, not across the room;
+- their colours do not differ, and a matcher that reads appearance takes it for the older one
+  with place left out (:func:`~.anchor_comparison.score_anywhere`; a view off its place is
+  judged by its look, as a search judges a found object);
+- exactly one older anchor fits: two that were both away (look-alikes side by side) leave it
+  undecided, and it stays.
+
+A look-alike put beside an object while it is away, and taken away as it comes back, would fit
+too; a scene that stages that is not told apart by anything the camera sees.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.features import extent_slack
+from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.same_space import Duplicate
+
+
+def decide_stand_ins(
+    went_missing: Iterable[Anchor], came_back: Iterable[Anchor], index: AnchorIndex, reach: float,
+    colour: ColourEvidenceConfig, matcher: Matcher, match_threshold: float,
+) -> list[Duplicate]:
+    """Stand-ins among the anchors that ``went_missing`` this frame, and among the MISSING anchors
+    beside those that ``came_back`` this frame (confirmed again after an absence); 0 ``reach``
+    turns the rule off."""
+    if reach <= 0.0:
+        return []
+    in_question = {anchor.symbol: anchor for anchor in went_missing if anchor.state is AnchorState.MISSING}
+    for anchor in came_back:
+        if anchor.state is AnchorState.CONFIRMED and anchor.absence is not None:
+            in_question.update((other.symbol, other) for other in _beside(anchor, index, reach)
+                               if other.state is AnchorState.MISSING)
+    decisions: list[Duplicate] = []
+    for symbol in sorted(in_question):
+        stand_in = in_question[symbol]
+        if stand_in.expectation is not None:
+            continue
+        originals = [older for older in _beside(stand_in, index, reach)
+                     if _was_away_all_its_life(older, stand_in) and not colours_differ(older.colour, stand_in.colour,
+                                                                                         colour)]
+        if len(originals) != 1:
+            continue
+        original = originals[0]
+        score = score_anywhere(matcher, stand_in, original) if matcher.uses_appearance else None
+        if score is not None and score < match_threshold:
+            continue
+        distance = float(np.linalg.norm(stand_in.position[:2] - original.position[:2]))
+        decisions.append(Duplicate(original, stand_in, 0.0,
+                                   f"seen only while {original.symbol} was away, {distance:.2f} m from it", score))
+    return decisions
+
+
+def _was_away_all_its_life(older: Anchor, stand_in: Anchor) -> bool:
+    """Whether ``older`` (confirmed, nothing expected of it, of the stand-in's class and born
+    before it) was away from the stand-in's first sighting to after its last."""
+    if (older.state is not AnchorState.CONFIRMED or older.absence is None or older.expectation is not None
+            or older.class_name != stand_in.class_name or older.first_seen >= stand_in.first_seen):
+        return False
+    last_sighting, back = older.absence
+    return last_sighting <= stand_in.first_seen and stand_in.last_seen < back
+
+
+def _beside(anchor: Anchor, index: AnchorIndex, reach: float) -> list[Anchor]:
+    """Other anchors of its class whose centre is within ``reach`` of its own (horizontally), plus
+    what the larger of the two extents explains."""
+    own_slack = float(extent_slack(anchor.size))
+    slots = index.within(anchor.position.reshape(1, 3), reach + max(own_slack, index.largest_extent_slack()))[0]
+    distance = np.linalg.norm(index.positions_of(slots)[:, :2] - anchor.position[:2], axis=1)
+    slack = np.maximum(index.extent_slacks_of(slots), own_slack)
+    return [other for other in index.anchors_at(slots[distance - slack <= reach])
+            if other is not anchor and other.class_name == anchor.class_name]
