@@ -11,6 +11,13 @@ calibrated for one view, and the best of ten views of a green mug scored 0.74 ag
 blue mug where their median was 0.24; one lucky view is not evidence that the whole anchor is
 the lost object.
 
+The lost anchor's last sighting is the one before it went missing (``lost_after``), not a
+sighting while missing, too few to bring it back, which may have been of the very candidate: in
+`twin_moved` (network, seed 3, 4 December) the search never took the moved mug's new anchor for
+it; at the end of the run the sought anchor's latest sighting, while missing, was 148 s after the
+candidate's first, which makes the time between them negative and the network's score 0.46, under
+the threshold; from its last sighting before it went missing, 0.57.
+
 For a search, where the lost object is sought is a disc rather than a point: the lost anchor is
 measured from that disc (anywhere in it counts as in place), as the matching table measures a
 searched anchor; every other feature is unchanged.
@@ -55,6 +62,11 @@ def identity_scores(
                   & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0])
     percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
     anchors = AnchorColumns.from_anchors([lost])
+    if lost.lost_after is not None:
+        # Its last sighting is the one before it went missing, as for who may be it at all
+        # (identity_repair._possible): a sighting while missing, too few to bring it back, may
+        # have been of the very candidate, which would then seem seen before it was lost.
+        anchors = dataclasses.replace(anchors, last_seen=np.array([lost.lost_after], dtype=np.float64))
     if disc is None:
         anchors = dataclasses.replace(anchors, perceived_positions=None, search_radii=None)
     else:

@@ -62,3 +62,31 @@ def test_a_search_measures_the_lost_anchor_from_the_searched_disc():
 
 def test_no_candidates_give_no_scores():
     assert identity_scores(AppearanceOnly(), [], anchor("cup_1", [[1.0]])).shape == (0,)
+
+
+class TimeOnly(Matcher):
+    """The time feature alone: how the gap between the candidate's first sighting and the lost
+    anchor's last one is measured."""
+
+    uses_appearance = False
+
+    @property
+    def feature_config(self) -> FeatureConfig:
+        return FeatureConfig()
+
+    def score_pairs(self, features: PairFeatures) -> np.ndarray:
+        return features.time_difference
+
+
+def test_a_lost_anchor_is_last_seen_when_it_went_missing_not_at_a_sighting_while_missing():
+    """A sighting while missing, too few to bring it back (perhaps of the candidate itself), does
+    not make the candidate seem seen before the lost object was."""
+    from merlin2_sailor.anchoring.anchor import AnchorState
+
+    lost = anchor("cup_1", [[1.0, 0.0]], stamp=100.0)
+    candidate = anchor("cup_2", [[1.0, 0.0]], stamp=160.0)
+    lost.state, lost.lost_after, lost.last_seen = AnchorState.MISSING, 100.0, 300.0
+    for disc in (None, SearchedDisc(np.zeros(3), 3.0)):
+        assert identity_scores(TimeOnly(), [candidate], lost, disc) == pytest.approx([60.0])
+    lost.lost_after = None  # back, or never lost: its latest sighting is its last
+    assert identity_scores(TimeOnly(), [candidate], lost) == pytest.approx([-140.0])
