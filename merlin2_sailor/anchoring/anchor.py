@@ -12,6 +12,7 @@ callers read them. Fusion rules live in :mod:`.fusion`, lifecycle rules in :mod:
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
 from enum import Enum
 
@@ -31,6 +32,10 @@ from merlin2_sailor.anchoring.fusion import FusionConfig, fuse_position, fuse_si
 from merlin2_sailor.anchoring.gallery import add_view, from_bfloat16_bits, view_scales
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
+
+#: Sightings an anchor remembers the stamps of: four seconds at 15 frames a second, more than a
+#: momentary pose error's stand-in lives (:mod:`.stand_in`).
+RECENT_SIGHTINGS = 64
 
 
 class AnchorState(Enum):
@@ -104,13 +109,9 @@ class Anchor:
     lost_after: float | None = None
     """While MISSING: its last sighting before it went missing (later sightings while missing,
     too few to bring it back, do not count): an anchor born after it may be the object, moved."""
-    returning_since: float | None = None
-    """While MISSING: the first of the sightings now bringing it back (None: none yet)."""
-    absence: tuple[float, float] | None = None
-    """Its latest absence, from its last sighting before it went MISSING to the first sighting of
-    the run that brought it back (None: never missing and back): an anchor of its class born
-    beside it and seen only within that time may have been it, seen off its place
-    (:mod:`.stand_in`). Not persisted: it matters for seconds."""
+    recent_sightings: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT_SIGHTINGS))
+    """The stamps of its latest sightings, oldest first: whether it was seen while a newcomer beside
+    it was (:mod:`.stand_in`). Not persisted: it matters for seconds."""
     provenance: Provenance = Provenance.PERCEIVED
     """PERCEIVED when ``position`` comes from the camera, EXPECTED when from an action's effect."""
     perceived_position: np.ndarray = field(default_factory=_zero_vector)
@@ -162,6 +163,7 @@ class Anchor:
             visible=True,
             perceived_position=position.copy(),
         )
+        anchor.recent_sightings.append(percept.stamp)
         if embedding is not None and not partial:
             anchor.gallery, anchor.gallery_scales = add_view(None, None, embedding, view_scale(percept),
                                                              config.gallery_size)
@@ -200,6 +202,7 @@ class Anchor:
         if percept.tracker_id:
             self.last_tracker_id = percept.tracker_id
         self.last_seen = max(self.last_seen, percept.stamp)
+        self.recent_sightings.append(percept.stamp)
         self.perceived_position = self.position.copy()
         self.provenance = Provenance.PERCEIVED
         self.visible = True

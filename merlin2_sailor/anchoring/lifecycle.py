@@ -60,17 +60,12 @@ def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
     detection near its old place must not tell a planner that a lost object is found.
     """
     if anchor.state is AnchorState.MISSING:
-        if anchor.recovery_sightings == 0:
-            anchor.returning_since = anchor.last_seen
         anchor.recovery_sightings += 1
         if anchor.recovery_sightings < config.confirm_after:
             return False
         anchor.recovery_sightings = 0
         anchor.state = AnchorState.CONFIRMED
-        if anchor.lost_after is not None:
-            anchor.absence = (anchor.lost_after, anchor.returning_since or anchor.last_seen)
         anchor.lost_after = None
-        anchor.returning_since = None
         return True
     if was_confirmed(anchor, config):
         became_confirmed = anchor.state is AnchorState.TENTATIVE
@@ -87,7 +82,6 @@ def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleCon
     """
     if anchor.state is AnchorState.MISSING:
         anchor.recovery_sightings = 0  # sightings must be near in time to bring it back
-        anchor.returning_since = None
         return False
     anchor.missed_frames += 1
     if anchor.missed_frames < config.missed_frames_to_missing:

@@ -16,9 +16,11 @@ What it decides. A MISSING anchor is a stand-in for an older anchor of its class
 as a :class:`~.same_space.Duplicate`, the older symbol kept, as the planner knows it) when all of
 these hold:
 
-- its whole life, first to last sighting, lies inside the older anchor's latest absence (from the
-  older one's last sighting before it went MISSING to the first sighting that brought it back):
-  the two were never seen at one time, so one object may have been both;
+- the older anchor was not seen from its first sighting to its last, and has been seen since (each
+  anchor remembers the stamps of its last 64 sightings, :data:`~.anchor.RECENT_SIGHTINGS`): the two
+  were never seen at one time, so one object may have been both. Whether the older one went
+  MISSING meanwhile does not matter: a glitch of two frames leaves it CONFIRMED, and the newcomer,
+  confirmed within three, MISSING beside it (`removed`, network, seed 4: a mug seen 0.19 m off);
 - it stands within ``reach`` of the older one (horizontally, plus what the larger of the two
   objects' extents explains): where the object was, not across the room;
 - their colours do not differ, and a matcher that reads appearance takes it for the older one
@@ -51,15 +53,14 @@ def decide_stand_ins(
     colour: ColourEvidenceConfig, matcher: Matcher, match_threshold: float,
 ) -> list[Duplicate]:
     """Stand-ins among the anchors that ``went_missing`` this frame, and among the MISSING anchors
-    beside those that ``came_back`` this frame (confirmed again after an absence); 0 ``reach``
+    beside those that ``came_back`` this frame (confirmed again after being missing); 0 ``reach``
     turns the rule off."""
     if reach <= 0.0:
         return []
     in_question = {anchor.symbol: anchor for anchor in went_missing if anchor.state is AnchorState.MISSING}
     for anchor in came_back:
-        if anchor.state is AnchorState.CONFIRMED and anchor.absence is not None:
-            in_question.update((other.symbol, other) for other in _beside(anchor, index, reach)
-                               if other.state is AnchorState.MISSING)
+        in_question.update((other.symbol, other) for other in _beside(anchor, index, reach)
+                           if other.state is AnchorState.MISSING)
     decisions: list[Duplicate] = []
     for symbol in sorted(in_question):
         stand_in = in_question[symbol]
@@ -82,12 +83,15 @@ def decide_stand_ins(
 
 def _was_away_all_its_life(older: Anchor, stand_in: Anchor) -> bool:
     """Whether ``older`` (confirmed, nothing expected of it, of the stand-in's class and born
-    before it) was away from the stand-in's first sighting to after its last."""
-    if (older.state is not AnchorState.CONFIRMED or older.absence is None or older.expectation is not None
+    before it) was not seen from the stand-in's first sighting to its last, and was seen since."""
+    if (older.state is not AnchorState.CONFIRMED or older.expectation is not None
             or older.class_name != stand_in.class_name or older.first_seen >= stand_in.first_seen):
         return False
-    last_sighting, back = older.absence
-    return last_sighting <= stand_in.first_seen and stand_in.last_seen < back
+    sightings = np.asarray(older.recent_sightings, dtype=np.float64)
+    if len(sightings) == 0 or (sightings[0] > stand_in.first_seen and len(sightings) < older.times_seen):
+        return False  # its sightings then are no longer remembered: nothing says it was away
+    during = (sightings >= stand_in.first_seen) & (sightings <= stand_in.last_seen)
+    return not during.any() and bool((sightings > stand_in.last_seen).any())
 
 
 def _beside(anchor: Anchor, index: AnchorIndex, reach: float) -> list[Anchor]:

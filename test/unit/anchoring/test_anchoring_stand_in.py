@@ -5,8 +5,8 @@ jumped for half a second, a cup and a book were seen 0.15-0.17 m off their ancho
 matcher (which reads how many widths a view stands from an anchor) took them for neighbours and
 anchored them anew, and when the pose came back the old anchors did too, leaving the new ones
 MISSING beside them for good. Tested below end to end with a matcher that, like the network,
-rejects a view two widths off, on other objects, shifts and timings than that run's; then the
-rule's limits one by one.
+rejects a view more than a width off, on other objects, shifts and timings than that run's (and a
+glitch too short for the old anchor to go missing); then the rule's limits one by one.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
 from merlin2_sailor.anchoring.features import PairFeatures
 from merlin2_sailor.anchoring.identity_repair import RepairConfig
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.stand_in import decide_stand_ins
 from merlin2_sailor.errors import ConfigurationError
@@ -47,11 +48,12 @@ SCENE = (
 
 
 def run(shifts: dict[str, tuple[float, float]], glitch_frames: range, stand_in_distance: float = 0.25,
-        glitch_looks_like: str = "", seed: int = 7):
+        glitch_looks_like: str = "", seed: int = 7, missed_frames_to_missing: int = 3):
     """60 frames of the scene, the objects named in ``shifts`` seen off their places by those
     (x, y) offsets during ``glitch_frames``; the anchors left and the events."""
     maker = PerceptMaker(seed=seed)
-    config = AnchoringConfig(repair=RepairConfig(stand_in_distance=stand_in_distance))
+    config = AnchoringConfig(repair=RepairConfig(stand_in_distance=stand_in_distance),
+                             lifecycle=LifecycleConfig(missed_frames_to_missing=missed_frames_to_missing))
     anchoring = Anchoring(config, WidthWary())
     stamp, events = 0.0, []
     for frame in range(60):
@@ -86,6 +88,15 @@ def test_a_pose_glitch_leaves_each_object_one_anchor_under_its_first_symbol(shif
     assert sum(a.state is AnchorState.MISSING for a in anchors) == len(shifts)
 
 
+def test_an_anchor_that_never_went_missing_meanwhile_is_found_behind_its_stand_in_too():
+    """A glitch shorter than it takes the old anchor to go missing (here 4 frames of 6), long
+    enough for the stand-in to be confirmed (3)."""
+    anchors, events = run({"bottle": (0.0, 0.2)}, range(20, 24), missed_frames_to_missing=6)
+    assert sorted(a.symbol for a in anchors) == ["bottle_1", "bowl_1", "vase_1"]
+    assert not [e for e in events if e.kind is AnchorEventKind.MISSING and e.symbol == "bottle_1"]
+    assert [e.symbol for e in events if e.kind is AnchorEventKind.FORGOTTEN] == ["bottle_2"]
+
+
 def test_a_newcomer_that_does_not_look_like_the_anchor_that_was_away_stays():
     """Another vase put there for the glitch's time: the appearance rules it out."""
     anchors, events = run({"vase": (0.0, 0.22)}, range(20, 28), glitch_looks_like="another_vase")
@@ -95,11 +106,15 @@ def test_a_newcomer_that_does_not_look_like_the_anchor_that_was_away_stays():
 
 # --- the rule's limits, on anchors as the coordinator holds them -----------------------------
 
+AWAY = (19.8, 19.9, 20.0, 21.0, 21.1)
+"""Sightings of an anchor away from 20.0 to 21.0."""
+
+
 def cup(symbol: str, y: float, state: AnchorState, first_seen: float, last_seen: float,
-        absence: tuple[float, float] | None = None, hue: int | None = None) -> Anchor:
+        sightings: tuple[float, ...] = (), hue: int | None = None) -> Anchor:
     anchor = Anchor(symbol, "cup", np.array((2.0, y, 0.8)), np.array((0.1, 0.1, 0.12)), first_seen, last_seen,
-                    state=state, perceived_position=np.array((2.0, y, 0.8)))
-    anchor.absence = absence
+                    state=state, perceived_position=np.array((2.0, y, 0.8)), times_seen=max(len(sightings), 1))
+    anchor.recent_sightings.extend(sightings)
     if hue is not None:
         anchor.colour = ColourModel.of(mug_colour(hue))
         for _ in range(4):
@@ -115,7 +130,7 @@ def decide(went_missing: list[Anchor], *others: Anchor, reach: float = 0.25):
 
 
 def test_the_newcomer_goes_and_the_older_symbol_stays():
-    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0))
+    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)
     stand_in = cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)
     [duplicate] = decide([stand_in], original)
     assert (duplicate.kept, duplicate.duplicate) == (original, stand_in)
@@ -123,34 +138,44 @@ def test_the_newcomer_goes_and_the_older_symbol_stays():
 
 
 @pytest.mark.parametrize(("first_seen", "last_seen"), [
-    (19.5, 20.8),  # seen before the older one went: they stood together
-    (20.1, 21.0),  # still seen when it was back
+    (19.85, 20.8),  # seen before the older one went: they stood together
+    (20.1, 21.05),  # still seen when it was back
 ])
 def test_a_newcomer_seen_while_the_older_was_there_is_another_object(first_seen, last_seen):
-    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0))
+    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, first_seen, last_seen)], original) == []
 
 
 def test_one_that_could_be_either_of_two_anchors_away_is_left_undecided():
-    left = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0))
-    right = cup("cup_3", 0.3, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0))
+    left = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)
+    right = cup("cup_3", 0.3, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)
     assert decide([cup("cup_2", 0.15, AnchorState.MISSING, 20.1, 20.8)], left, right) == []
 
 
 def test_one_of_another_colour_or_too_far_or_with_the_rule_off_stays():
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8, hue=GREEN)],
-                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0), hue=RED)) == []
+                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY, hue=RED)) == []
     assert decide([cup("cup_2", 0.6, AnchorState.MISSING, 20.1, 20.8)],
-                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0))) == []
+                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)) == []
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)],
-                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, absence=(20.0, 21.0)), reach=0.0) == []
+                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY), reach=0.0) == []
 
 
 def test_an_anchor_never_away_or_younger_has_no_stand_in():
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)],
-                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0)) == []
+                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=(20.0, 20.5, 21.0))) == []
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)],
-                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 20.2, 30.0, absence=(20.0, 21.0))) == []
+                  cup("cup_1", 0.0, AnchorState.CONFIRMED, 20.2, 30.0, sightings=AWAY)) == []
+
+
+def test_an_anchor_whose_sightings_then_are_forgotten_tells_nothing():
+    """64 sightings since the newcomer's time: whether it was seen then is no longer known."""
+    later = tuple(21.0 + k / 15.0 for k in range(64))
+    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=later)
+    original.times_seen = 500
+    assert decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)], original) == []
+    original.times_seen = 64  # all it ever saw: it was not seen then
+    assert len(decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)], original)) == 1
 
 
 def test_the_distance_is_checked():
