@@ -16,11 +16,12 @@ What it decides. A MISSING anchor is a stand-in for an older anchor of its class
 as a :class:`~.same_space.Duplicate`, the older symbol kept, as the planner knows it) when all of
 these hold:
 
-- the older anchor was not seen from its first sighting to its last, and has been seen since (each
-  anchor remembers the stamps of its last 64 sightings, :data:`~.anchor.RECENT_SIGHTINGS`): the two
-  were never seen at one time, so one object may have been both. Whether the older one went
-  MISSING meanwhile does not matter: a glitch of two frames leaves it CONFIRMED, and the newcomer,
-  confirmed within three, MISSING beside it (`removed`, network, seed 4: a mug seen 0.19 m off);
+- the older anchor was not seen from the newcomer's first sighting to its last, and has been seen
+  since (each anchor remembers the stamps of its last 64 sightings,
+  :data:`~.anchor.RECENT_SIGHTINGS`): the two were never seen at one time, so one object may have
+  been both. Whether the older one went MISSING meanwhile does not matter: a short glitch may leave
+  it CONFIRMED while the newcomer is confirmed in three frames (`removed`, network, seed 4: a mug
+  seen 0.19 m off became a second anchor while its own never went missing);
 - it stands within ``reach`` of the older one (horizontally, plus what the larger of the two
   objects' extents explains): where the object was, not across the room;
 - their colours do not differ, and a matcher that reads appearance takes it for the older one
