@@ -15,7 +15,7 @@ from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import ExpectationKind
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting, before_sighting
 from merlin2_sailor.anchoring.partial_view import smaller_than_known
 from merlin2_sailor.anchoring.percept_checks import position_text
 from merlin2_sailor.contract.percept import Percept
@@ -53,6 +53,7 @@ def reacquire(
     was_missing = anchor.state is AnchorState.MISSING
     missing_since = anchor.missing_since
     partial = partial or smaller_than_known(percept, anchor)
+    before_sighting(anchor, percept.stamp, lifecycle)
     anchor.absorb(percept, percept.embedding, fusion, partial)
     became_confirmed = after_sighting(anchor, lifecycle)
     if anchor.state is AnchorState.MISSING:

@@ -112,6 +112,24 @@ def test_object_leaving_and_reentering_view_is_reacquired_with_its_symbol(make_a
     assert back.acquired == ()
 
 
+def test_sightings_of_a_tentative_anchor_far_apart_do_not_confirm_it(make_anchoring, maker, kitchen):
+    """A false detection that the camera's view never checks (out of view, or hidden), seen again
+    at that spot now and then, is not an object: its count starts again (here 12 s apart)."""
+    anchoring = make_anchoring()  # confirm_after = 2, confirm_within = 10 s
+    cup = kitchen["red_cup"]
+    turned_away = camera_view(yaw=math.pi)
+    stamps = (0.0, 12.0, 24.0)
+    for stamp in stamps:
+        result = anchoring.process([maker.percept(cup, stamp)], camera_view(), stamp)
+        assert result.percept_symbols == ("cup_1",)
+        assert AnchorEventKind.CONFIRMED not in kinds(result)
+        anchoring.process([], turned_away, stamp + 0.5)
+    assert anchoring.get("cup_1").state is AnchorState.TENTATIVE
+    # Two sightings a frame apart confirm it, under the symbol it had.
+    result = anchoring.process([maker.percept(cup, 24.0 + FRAME)], camera_view(), 24.0 + FRAME)
+    assert AnchorEventKind.CONFIRMED in kinds(result) and anchoring.get("cup_1").state is AnchorState.CONFIRMED
+
+
 def test_occluded_object_is_not_marked_missing(make_anchoring, maker, kitchen):
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
