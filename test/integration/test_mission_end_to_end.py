@@ -115,8 +115,13 @@ def run_story(data: Path, knowledge: Path, node_process, ros_probe) -> None:
     assert f"approach_object({mug}, kitchen)" in account  # the first plan trusted the old fact
     assert "replanning" in account
     # Aries returns the first plan it finds, not the shortest: the replan may start the search at
-    # another waypoint (driving there first) rather than where the robot stands.
-    assert re.search(rf"find_object\({mug}, \w+\) succeeded", account), account
+    # another waypoint (driving there first) rather than where the robot stands. Or no search is
+    # needed: driving there, the camera may watch the bedroom before the mug appears in it, and the
+    # anchoring layer then takes the mug seen there for the lost one (a relocation), so the next
+    # plan approaches it where it now is (CI, 4 December).
+    found_by_search = re.search(rf"find_object\({mug}, \w+\) succeeded", account)
+    found_on_the_way = f"forgotten: moved: it appeared where the camera had watched: it is {mug}" in account
+    assert found_by_search or found_on_the_way, account
     assert f"- object_at({mug}, kitchen)" in account  # the retraction, as it happened
     # The knowledge base tells the truth, under the same symbol: no second cup was anchored.
     assert facts(knowledge, "object_at") >= {(mug, "bedroom")}
