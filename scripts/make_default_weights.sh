@@ -6,7 +6,7 @@
 # Deterministic given the seed (up to floating-point differences between machines).
 # Rendered scenes and embeddings are cached under $SAILOR_CACHE (default ~/.cache/merlin2_sailor),
 # so a second run renders and embeds nothing.
-# Usage: scripts/make_default_weights.sh            (about 8 minutes on 2 CPU cores, 1-2 when cached; then 2 minutes of tours)
+# Usage: scripts/make_default_weights.sh            (about 17 minutes on 2 CPU cores, 4 when cached; then 2 minutes of tours)
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -207,6 +207,17 @@ class AnchorIndex:
             found[row] = np.sort(np.concatenate((slots, pending[pending_close[row]])))
         return found
 
+    def near(self, anchor: Anchor, reach: float, horizontal: bool = False) -> list[Anchor]:
+        """The other anchors whose centre lies within ``reach`` of ``anchor``'s, plus what the larger
+        of the two extents explains (views of a large object are not centred alike); ``horizontal``
+        measures on the floor only (a place seen from another height is the same place)."""
+        own_slack = float(extent_slack(anchor.size))
+        slots = self.within(anchor.position.reshape(1, 3), reach + max(own_slack, self.largest_extent_slack()))[0]
+        axes = slice(0, 2) if horizontal else slice(0, 3)
+        distance = np.linalg.norm(self.positions_of(slots)[:, axes] - anchor.position[axes], axis=1)
+        slack = np.maximum(self.extent_slacks_of(slots), own_slack)
+        return [other for other in self.anchors_at(slots[distance - slack <= reach]) if other is not anchor]
+
     # --- internals --------------------------------------------------------------------------
 
     def _write(self, slot: int, anchor: Anchor) -> None:

@@ -29,9 +29,9 @@ them. They are encoded as the public implementation encodes them, except time:
 - appearance: the element-wise L1 difference ``|f_p - f_a|`` of the frozen backbone's features,
   the siamese branch's input. An anchor keeps a gallery of recent features; the gallery entry
   nearest the percept (smallest L1 norm) is used, so an object is recognised from whichever side
-  it was last seen. An embedding may end with the crop's colour descriptor
-  (:mod:`merlin2_sailor.perception.colour_histogram`); its part of the difference is carried
-  along, and the network reads it as a colour similarity of its own.
+  it was last seen. An embedding may end with the crop's colour and layout descriptor
+  (:mod:`merlin2_sailor.perception.crop_descriptor`); its part of the difference is carried
+  along, and the network reads it as similarities of its own.
 
 - searched: 1 when the anchor is being searched for (an expectation with a radius): its distance
   is then measured from the searched disc, so anywhere in it is "here" and the place says
@@ -63,8 +63,9 @@ from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 #: Version of the encoding above; bump it whenever an encoding changes. 2: the distance score is
 #: that of the footprint distance (1: of the plain distance), and the searched feature is new;
 #: 3: embeddings end with the crop's colour descriptor (centre and surround histograms), compared
-#: as a feature of its own; 4: the separation in object widths is new.
-FEATURE_ENCODING_VERSION = 4
+#: as a feature of its own; 4: the separation in object widths is new; 5: the crop descriptor
+#: also holds a thumbnail of the crop's layout, read as two more similarities.
+FEATURE_ENCODING_VERSION = 5
 
 #: Pairs whose appearance is compared at once; bounds each (pairs, D) temporary to ~5 MB.
 APPEARANCE_CHUNK_PAIRS = 1024

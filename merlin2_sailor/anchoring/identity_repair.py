@@ -54,7 +54,6 @@ from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_sc
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_agree, colours_differ
 from merlin2_sailor.anchoring.expectation import Expectation
-from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.errors import ConfigurationError
 
@@ -333,15 +332,8 @@ class IdentityRepair:
         )
 
     def _near(self, anchor: Anchor, index: AnchorIndex) -> list[Anchor]:
-        """Other anchors whose centre lies within the reappearance distance of this one's, plus
-        what either's extent explains (views of a large object are not centred alike)."""
-        reach = self.config.reappearance_distance
-        own_slack = float(extent_slack(anchor.size))
-        radius = reach + max(own_slack, index.largest_extent_slack())
-        slots = index.within(anchor.position.reshape(1, 3), radius)[0]
-        distance = np.linalg.norm(index.positions_of(slots) - anchor.position, axis=1)
-        slack = np.maximum(index.extent_slacks_of(slots), own_slack)
-        return [other for other in index.anchors_at(slots[distance - slack <= reach]) if other is not anchor]
+        """Other anchors within the reappearance distance of this one (see :meth:`AnchorIndex.near`)."""
+        return index.near(anchor, self.config.reappearance_distance)
 
 
 def _in_question(lost: Iterable[Anchor], brought_in: Iterable[Anchor]) -> list[Anchor]:

@@ -1,8 +1,9 @@
 """The paper's matching network M and the matcher that runs it, with self-describing weights.
 
 Architecture (D is the frozen backbone's feature size, 1280 for EfficientNet-Lite0, 512 for
-ResNet-18; K the colour descriptor's, 42, that ends each embedding: histograms of the crop's centre
-and surround, see :mod:`merlin2_sailor.perception.colour_histogram`; S, B, C1 and C2 are sizes of
+ResNet-18; K the crop descriptor's, 186, that ends each embedding: histograms of the crop's centre
+and surround and a thumbnail of its layout, see :mod:`merlin2_sailor.perception.crop_descriptor`;
+S, B, C1 and C2 are sizes of
 :class:`NetworkMetadata`):
 
 - siamese branch: ``|f_p - f_a|`` over the backbone's D features -> Linear(D, S) -> ReLU. The
@@ -14,14 +15,17 @@ and surround, see :mod:`merlin2_sailor.perception.colour_histogram`; S, B, C1 an
 - PerceptAnchor network: one Linear(., B) + ReLU per feature (same class, siamese output,
   distance (two values: metres and object widths apart, see :mod:`.features`), scale,
   time; searched: whether the distance was measured from a searched disc, see
-  :mod:`.features`; colour: the intersections of the two crops' centre and surround histograms (2
-  values), from the last K values of the same ``|f_p - f_a|``), concatenated (7 x B) -> Linear(7 B, B) -> ReLU;
+  :mod:`.features`; colour: the intersections of the two crops' centre and surround histograms and their layouts'
+  lightness correlation and colour closeness (4 values), from the last K values of the same
+  ``|f_p - f_a|``), concatenated (7 x B) -> Linear(7 B, B) -> ReLU;
 - binary classifier: Dropout(0.5) -> Linear(B, C1) -> ReLU -> Linear(C1, C2) -> ReLU ->
   Linear(C2, 1), and a sigmoid.
 
 The colour branch is new: the backbone's pooled features hold colour weakly, so the version
 without it took the green mug for the red one it had never been shown beside (their features are
-as close as two views of the red mug); two values per pair, it adds 1 % to the weights. The
+as close as two views of the red mug); four values per pair, it adds 1 % to the weights. The
+layout's two values came later: neither pooled features nor histograms tell a picture from its
+mirror image or from another cut of the same photo (see :mod:`merlin2_sailor.perception.layout_thumbnail`). The
 public SAILOR implementation has five feature branches (no searched one, no colour), S = 512, B = 256
 and (C1, C2) = (1024, 256): 1.6 million weights. The defaults here are a quarter of each
 (S = 256, B = 64, (C1, C2) = (256, 64): 0.4 million): trained on the house source, both reached
@@ -54,7 +58,7 @@ from merlin2_sailor.anchoring.network_inputs import (
     network_inputs,
 )
 from merlin2_sailor.errors import ConfigurationError, DependencyError, SailorError
-from merlin2_sailor.perception.colour_histogram import COLOUR_REGIONS
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIMILARITIES
 
 try:
     import torch
@@ -87,7 +91,7 @@ class MatchingNetwork(nn.Module):
         self.scale_branch = _dense(1, units)
         self.time_branch = _dense(1, units)
         self.search_branch = _dense(1, units)
-        self.colour_branch = _dense(COLOUR_REGIONS, units)
+        self.colour_branch = _dense(DESCRIPTOR_SIMILARITIES, units)
         self.merge = _dense(7 * units, units)
         hidden, last_hidden = self.metadata.classifier_units
         self.classifier = nn.Sequential(
@@ -109,7 +113,7 @@ class MatchingNetwork(nn.Module):
     ) -> torch.Tensor:
         """Return (N,) logits. Scalars are (N,) or (N, 1) encoded features, the difference (N, D)
         of the backbone's features only, ``distance`` (N, 2) (its score and the separation's),
-        ``colour`` (N, 2) (see :meth:`inputs_from`)."""
+        ``colour`` (N, 4) (see :meth:`inputs_from`)."""
         if self.metadata.appearance_dropout and self.training:
             appearance_difference = nn.functional.dropout(appearance_difference, self.metadata.appearance_dropout)
         merged = torch.cat(
@@ -120,7 +124,7 @@ class MatchingNetwork(nn.Module):
                 self.scale_branch(scale.reshape(-1, 1)),
                 self.time_branch(time.reshape(-1, 1)),
                 self.search_branch(searched.reshape(-1, 1)),
-                self.colour_branch(colour.reshape(-1, COLOUR_REGIONS)),
+                self.colour_branch(colour.reshape(-1, DESCRIPTOR_SIMILARITIES)),
             ),
             dim=1,
         )

@@ -18,7 +18,7 @@ from merlin2_sailor.anchoring.features import FEATURE_ENCODING_VERSION, FeatureC
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.errors import ConfigurationError, SailorError
-from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, COLOUR_REGIONS, colour_similarity
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIMILARITIES, DESCRIPTOR_SIZE, descriptor_similarity
 
 #: The network's inputs in the order of its forward pass (also the exported model's input names).
 INPUT_NAMES = ("same_class", "appearance_difference", "distance", "scale", "time", "searched", "colour")
@@ -32,8 +32,8 @@ class NetworkMetadata:
     """What a set of weights was trained with; stored in, and checked against, the weights file."""
 
     backbone: str = "efficientnet_lite0"
-    feature_dimension: int = 1280 + COLOUR_DESCRIPTOR_SIZE  # the whole embedding, colour included
-    colour_bins: int = COLOUR_DESCRIPTOR_SIZE  # its last values, the colour descriptor (0: none)
+    feature_dimension: int = 1280 + DESCRIPTOR_SIZE  # the whole embedding, crop descriptor included
+    colour_bins: int = DESCRIPTOR_SIZE  # its last values, the crop descriptor (0: none)
     feature_encoding_version: int = FEATURE_ENCODING_VERSION
     time_scale: float = 30.0
     siamese_units: int = 256
@@ -48,9 +48,9 @@ class NetworkMetadata:
         for name in ("feature_dimension", "siamese_units", "branch_units"):
             if getattr(self, name) < 1:
                 raise ConfigurationError(f"network {name} must be at least 1, got {getattr(self, name)}.")
-        if self.colour_bins not in (0, COLOUR_DESCRIPTOR_SIZE) or self.colour_bins >= self.feature_dimension:
+        if self.colour_bins not in (0, DESCRIPTOR_SIZE) or self.colour_bins >= self.feature_dimension:
             raise ConfigurationError(
-                f"network colour_bins must be 0 or {COLOUR_DESCRIPTOR_SIZE} (the colour descriptor's size) and "
+                f"network colour_bins must be 0 or {DESCRIPTOR_SIZE} (the crop descriptor's size) and "
                 f"below feature_dimension {self.feature_dimension}, got {self.colour_bins}."
             )
         object.__setattr__(self, "classifier_units", tuple(int(u) for u in self.classifier_units))
@@ -69,14 +69,14 @@ class NetworkMetadata:
 
     @property
     def backbone_dimension(self) -> int:
-        """The embedding's values before its colour descriptor: the siamese branch's input."""
+        """The embedding's values before its crop descriptor: the siamese branch's input."""
         return self.feature_dimension - self.colour_bins
 
 
 def network_inputs(metadata: NetworkMetadata, features: PairFeatures) -> tuple[np.ndarray, ...]:
     """The network's float32 inputs for every pair of ``features`` (appearance rows must be known),
     in :data:`INPUT_NAMES` order: the embedding difference is split into the backbone's part and
-    the colour similarity of the two crops' descriptors; the distance is (N, :data:`DISTANCE_VALUES`)."""
+    the similarities of the two crops' descriptors (colour and layout); the distance is (N, :data:`DISTANCE_VALUES`)."""
     if features.appearance_difference is None:
         raise SailorError("The matching network needs appearance; compute features with with_appearance=True.")
     if features.appearance_difference.shape[1] != metadata.feature_dimension:
@@ -91,8 +91,8 @@ def network_inputs(metadata: NetworkMetadata, features: PairFeatures) -> tuple[n
 
     backbone = metadata.backbone_dimension
     difference = features.appearance_difference
-    colour = (colour_similarity(difference[:, backbone:]) if metadata.colour_bins
-              else np.ones((len(difference), COLOUR_REGIONS)))
+    colour = (descriptor_similarity(difference[:, backbone:]) if metadata.colour_bins
+              else np.ones((len(difference), DESCRIPTOR_SIMILARITIES)))
     return (
         column(features.same_class),
         column(difference[:, :backbone]),

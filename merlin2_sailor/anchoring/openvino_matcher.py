@@ -28,7 +28,7 @@ from merlin2_sailor.errors import ConfigurationError, DependencyError
 from merlin2_sailor.inference.model_cache import MODEL_FILE, ExportedModel, ensure_exported, fingerprint
 from merlin2_sailor.inference.openvino_runtime import CompiledNetwork
 from merlin2_sailor.inference.settings import InferenceSettings
-from merlin2_sailor.perception.colour_histogram import COLOUR_REGIONS
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIMILARITIES
 
 MODEL_NAME = "matching-network"
 
@@ -49,9 +49,9 @@ def ensure_matching_network(weights: Path, backbone: str, folder: Path | None = 
         network = load_network(weights, backbone)
         metadata = network.metadata
         example = (torch.zeros(2), torch.zeros(2, metadata.backbone_dimension), torch.zeros(2, DISTANCE_VALUES),
-                   torch.zeros(2), torch.zeros(2), torch.zeros(2), torch.zeros(2, COLOUR_REGIONS))
+                   torch.zeros(2), torch.zeros(2), torch.zeros(2), torch.zeros(2, DESCRIPTOR_SIMILARITIES))
         shapes = [(-1,), (-1, metadata.backbone_dimension), (-1, DISTANCE_VALUES), (-1,), (-1,), (-1,),
-                  (-1, COLOUR_REGIONS)]
+                  (-1, DESCRIPTOR_SIMILARITIES)]
         save_torch_module(ProbabilityModule(network), example, shapes, target / MODEL_FILE, INPUT_NAMES)
         recorded = asdict(metadata)
         recorded["classifier_units"] = list(recorded["classifier_units"])

@@ -44,7 +44,6 @@ from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
-from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.same_space import Duplicate
 
@@ -96,11 +95,6 @@ def _was_away_all_its_life(older: Anchor, stand_in: Anchor) -> bool:
 
 
 def _beside(anchor: Anchor, index: AnchorIndex, reach: float) -> list[Anchor]:
-    """Other anchors of its class whose centre is within ``reach`` of its own (horizontally), plus
+    """Other anchors of its class whose centre is within ``reach`` of its own on the floor, plus
     what the larger of the two extents explains."""
-    own_slack = float(extent_slack(anchor.size))
-    slots = index.within(anchor.position.reshape(1, 3), reach + max(own_slack, index.largest_extent_slack()))[0]
-    distance = np.linalg.norm(index.positions_of(slots)[:, :2] - anchor.position[:2], axis=1)
-    slack = np.maximum(index.extent_slacks_of(slots), own_slack)
-    return [other for other in index.anchors_at(slots[distance - slack <= reach])
-            if other is not anchor and other.class_name == anchor.class_name]
+    return [other for other in index.near(anchor, reach, horizontal=True) if other.class_name == anchor.class_name]

@@ -1,8 +1,8 @@
 """Default weights that ship with the package: the matching network trained on the house source.
 
 ``matching_network_efficientnet_lite0.pt``: a :class:`~merlin2_sailor.anchoring.matching_network.MatchingNetwork`
-for EfficientNet-Lite0 crop features (1280-d) followed by the crop's colour descriptor (42
-values, see :mod:`merlin2_sailor.perception.colour_histogram`), written by ``save_network`` with
+for EfficientNet-Lite0 crop features (1280-d) followed by the crop's colour and layout
+descriptor (186 values, see :mod:`merlin2_sailor.perception.crop_descriptor`), written by ``save_network`` with
 its metadata header (backbone, feature sizes, feature encoding version, time scale). Beside it,
 ``matching_network_efficientnet_lite0.json`` records how it was made: the house source's
 configuration and fingerprint, the pair data set's hash, the training configuration, the

@@ -14,11 +14,12 @@ longer fit in the cache; on an accelerator large batches win. The backbone runs 
 by default (an export of the same torch module, several times faster on a CPU; see
 :mod:`.openvino_backbone`), or in torch with ``inference.runtime: native``.
 
-Each embedding ends with the crop's colour descriptor (:mod:`.colour_histogram`: 42 values, the
-histograms of its centre and its surround) unless ``colour_histogram`` is off: pooled ImageNet
-features keep the shape of an object and blur its colour, so a red and a green mug of one make
-are closer in them than two views of one mug. The descriptor costs about 0.2 ms a crop against
-the backbone's 3-38 ms (runtime and threads).
+Each embedding ends with the crop's descriptor (:mod:`.crop_descriptor`: 186 values, the
+histograms of its centre and its surround and a 6 x 6 thumbnail of its layout) unless
+``colour_histogram`` is off: pooled ImageNet features keep the shape of an object and blur its
+colour and where things are in it, so a red and a green mug of one make, or a picture and its
+mirror image, are closer in them than two views of one object. The descriptor costs about 0.2 ms
+a crop against the backbone's 3-38 ms (runtime and threads).
 """
 
 from __future__ import annotations
@@ -33,14 +34,14 @@ from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.backbone import Backbone
 from merlin2_sailor.perception.backbone_registry import create_backbone
-from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, colour_descriptors
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIZE, crop_descriptors
 
 
 @dataclass(frozen=True, slots=True)
 class EmbeddingConfig:
     """``backbone``: a name from :data:`~.backbone_registry.BACKBONES`; ``weights_path``: its weights file,
     when it has none bundled; ``batch_size``: crops per forward pass (4 suits a CPU, see above);
-    ``colour_histogram``: end each embedding with the crop's colour descriptor; ``inference``:
+    ``colour_histogram``: end each embedding with the crop's colour and layout descriptor; ``inference``:
     the runtime, device and threads the backbone runs with (OpenVINO by default)."""
 
     backbone: str = "efficientnet_lite0"
@@ -56,7 +57,7 @@ class EmbeddingConfig:
 
 class CropEmbedder:
     """``embed(crops)`` -> (N, D) float32: raw backbone features, then (when configured) the
-    crop's colour descriptor, one row per crop."""
+    crop's colour and layout descriptor, one row per crop."""
 
     def __init__(self, config: EmbeddingConfig | None = None, backbone: Backbone | None = None,
                  report: Callable[[str], None] | None = None) -> None:
@@ -66,8 +67,8 @@ class CropEmbedder:
 
     @property
     def colour_bins(self) -> int:
-        """How many values at the end of each embedding are the colour descriptor (0: none)."""
-        return COLOUR_DESCRIPTOR_SIZE if self.config.colour_histogram else 0
+        """How many values at the end of each embedding are the crop descriptor (0: none)."""
+        return DESCRIPTOR_SIZE if self.config.colour_histogram else 0
 
     @property
     def threads(self) -> int:
@@ -80,7 +81,7 @@ class CropEmbedder:
 
     @property
     def name(self) -> str:
-        """Names what the embeddings hold (e.g. ``efficientnet_lite0+colour42``): an embedding
+        """Names what the embeddings hold (e.g. ``efficientnet_lite0+colour186``): an embedding
         cache keeps embeddings of different makes apart by it."""
         return self.config.backbone + (f"+colour{self.colour_bins}" if self.colour_bins else "")
 
@@ -92,7 +93,7 @@ class CropEmbedder:
             batch = self._resized(crops[start : start + self.config.batch_size], start)
             features[start : start + len(batch), :backbone_dimension] = self.backbone.features(batch)
         if self.colour_bins:
-            features[:, backbone_dimension:] = colour_descriptors(crops)
+            features[:, backbone_dimension:] = crop_descriptors(crops)
         return features
 
     def _resized(self, crops: Sequence[np.ndarray], first_index: int) -> np.ndarray:

@@ -29,6 +29,7 @@ from merlin2_sailor.anchoring.matching_network import (  # noqa: E402
     save_network,
 )
 from merlin2_sailor.errors import ConfigurationError, DependencyError, SailorError  # noqa: E402
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIMILARITIES, DESCRIPTOR_SIZE  # noqa: E402
 
 from .anchoring_scenes import KITCHEN, TWIN_MUGS, SceneObject  # noqa: E402
 
@@ -43,12 +44,12 @@ def network() -> MatchingNetwork:
     ).eval()
 
 
-COLOUR_BINS = 42  # a colour descriptor: the histograms of a crop's centre and surround
+COLOUR_BINS = DESCRIPTOR_SIZE  # a crop descriptor: the histograms of a crop's centre and surround, its layout
 
 
 def random_inputs(count: int, dimension: int = DIMENSION):
     """Forward's inputs: same class, the backbone part of the difference, distance (metres and
-    widths apart), scale, time, searched, colour similarity."""
+    widths apart), scale, time, searched, the crops' similarities (colour, layout)."""
     generator = torch.Generator().manual_seed(1)
     return (
         torch.randint(0, 2, (count,), generator=generator).float(),
@@ -57,24 +58,26 @@ def random_inputs(count: int, dimension: int = DIMENSION):
         torch.rand(count, generator=generator),
         torch.rand(count, generator=generator),
         torch.randint(0, 2, (count,), generator=generator).float(),
-        torch.rand(count, 2, generator=generator),
+        torch.rand(count, DESCRIPTOR_SIMILARITIES, generator=generator),
     )
 
 
 def test_architecture_has_the_published_structure_with_the_default_sizes():
     network = MatchingNetwork()  # EfficientNet-Lite0 features + colour, S = 256, B = 64, (C1, C2) = (256, 64)
-    assert network.metadata.feature_dimension == 1280 + 42 and network.metadata.colour_bins == 42
+    assert network.metadata.feature_dimension == 1280 + DESCRIPTOR_SIZE
+    assert network.metadata.colour_bins == DESCRIPTOR_SIZE
     assert network.siamese[0].in_features == 1280 and network.siamese[0].out_features == 256
     assert network.siamese_branch[0].in_features == 256 and network.siamese_branch[0].out_features == 64
     for branch in (network.same_class_branch, network.scale_branch, network.time_branch, network.search_branch):
         assert (branch[0].in_features, branch[0].out_features) == (1, 64)
     assert (network.distance_branch[0].in_features, network.distance_branch[0].out_features) == (2, 64)
-    assert (network.colour_branch[0].in_features, network.colour_branch[0].out_features) == (2, 64)
+    # colour: two histogram intersections, then the layout's correlation and colour closeness
+    assert (network.colour_branch[0].in_features, network.colour_branch[0].out_features) == (4, 64)
     assert network.merge[0].in_features == 7 * 64 and network.merge[0].out_features == 64
     layers = [m for m in network.classifier if isinstance(m, torch.nn.Linear)]
     assert [(layer.in_features, layer.out_features) for layer in layers] == [(64, 256), (256, 64), (64, 1)]
     assert isinstance(network.classifier[0], torch.nn.Dropout) and network.classifier[0].p == 0.5
-    resnet = NetworkMetadata(backbone="resnet18", feature_dimension=512 + 42)
+    resnet = NetworkMetadata(backbone="resnet18", feature_dimension=512 + DESCRIPTOR_SIZE)
     assert MatchingNetwork(resnet).siamese[0].in_features == 512
 
 
@@ -111,6 +114,7 @@ def test_network_is_trainable(network):
 
 
 @pytest.mark.parametrize(("input_index", "column", "what"), [(6, 1, "the surround's colour similarity"),
+                                                              (6, 2, "the layout's lightness correlation"),
                                                               (2, 1, "the separation in object widths")])
 def test_the_network_can_learn_what_only_one_input_value_tells(network, input_index, column, what):
     network.train()
@@ -127,14 +131,20 @@ def test_the_network_can_learn_what_only_one_input_value_tells(network, input_in
     assert accuracy > 0.9
 
 
-def test_the_colour_descriptor_at_the_end_of_an_embedding_is_read_as_two_similarities(maker):
+def test_the_crop_descriptor_at_the_end_of_an_embedding_is_read_as_four_similarities(maker):
     from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
     from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
 
     def descriptor(centre_bin: int, surround_bin: int) -> np.ndarray:
-        """Histograms of 21 bins, all of the centre's pixels in one bin, all the surround's in another."""
+        """Histograms of 21 bins, all of the centre's pixels in one bin, all the surround's in another;
+        then a layout whose lightness pattern is one bright cell (where the surround's bin says)
+        and whose cells are all grey."""
         values = np.zeros(COLOUR_BINS, dtype=np.float32)
         values[centre_bin] = values[21 + surround_bin] = 1.0
+        layout = values[42:]
+        layout[:36] = -1.0 / 6.0 / 35 ** 0.5
+        layout[surround_bin] = 35 ** 0.5 / 6.0  # zero mean, unit norm
+        layout[36:] = 0.5
         return values
 
     torch.manual_seed(0)
@@ -150,8 +160,12 @@ def test_the_colour_descriptor_at_the_end_of_an_embedding_is_read_as_two_similar
                              np.arange(3), np.zeros(3, dtype=np.intp), network.metadata.feature_config, True)
     inputs = network.inputs_from(features)
     assert inputs[1].shape == (3, DIMENSION)  # the siamese branch sees the backbone's part only
-    # Histogram intersections of (centre, surround): same colours, another surround, nothing shared.
-    np.testing.assert_allclose(inputs[6].numpy(), [[1.0, 1.0], [1.0, 0.0], [0.0, 0.0]], atol=1e-6)
+    # Histogram intersections of (centre, surround): same colours, another surround, nothing shared;
+    # then the layouts' lightness correlation (the bright cell elsewhere: below zero) and colour
+    # closeness (the same grey cells).
+    correlation = 1.0 - 36 / 35 / 2 * 2  # two patterns of one bright cell in different places
+    expected = [[1.0, 1.0, 1.0, 1.0], [1.0, 0.0, correlation, 1.0], [0.0, 0.0, correlation, 1.0]]
+    np.testing.assert_allclose(inputs[6].numpy(), expected, atol=2e-2)
     assert len(set(network.probabilities(*inputs).tolist())) == 3  # and the score depends on them
 
 
@@ -300,5 +314,5 @@ def test_real_backbone_features_fill_the_galleries(maker):
     percept = dataclasses.replace(maker.percept(KITCHEN[0], 0.0, with_embedding=False), crop=crop)
     anchoring.process([percept], None, 0.0)
     (anchor,) = anchoring.anchors
-    assert anchor.gallery.shape == (1, 1280 + 42)  # the backbone's features, then the colour descriptor
+    assert anchor.gallery.shape == (1, 1280 + DESCRIPTOR_SIZE)  # the backbone's features, then the crop descriptor
     np.testing.assert_allclose(from_bfloat16_bits(anchor.gallery[0]), embedder.embed([crop])[0], rtol=1e-2, atol=1e-3)

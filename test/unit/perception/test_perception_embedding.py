@@ -10,7 +10,7 @@ import pytest
 
 from merlin2_sailor.errors import ConfigurationError, DependencyError, InvalidInputError
 from merlin2_sailor.perception.backbone_registry import create_backbone
-from merlin2_sailor.perception.colour_histogram import COLOUR_DESCRIPTOR_SIZE, colour_descriptors
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIZE, crop_descriptors
 
 from .scenes import load_darknet_image
 
@@ -58,7 +58,7 @@ def test_resnet18_backbone_loads_a_torchvision_file_and_gives_512_features(rando
     embedder = CropEmbedder(EmbeddingConfig(backbone="resnet18", weights_path=str(random_torchvision_weights)))
     crops = [np.full((50, 80, 3), 100, np.uint8), np.random.default_rng(0).integers(0, 255, (300, 200, 3), np.uint8)]
     features = embedder.embed(crops)
-    assert features.shape == (2, 512 + COLOUR_DESCRIPTOR_SIZE) and features.dtype == np.float32
+    assert features.shape == (2, 512 + DESCRIPTOR_SIZE) and features.dtype == np.float32
     assert np.all(np.isfinite(features)) and not np.allclose(features[0], features[1])
 
 
@@ -102,7 +102,7 @@ def test_same_object_under_scale_and_brightness_is_closer_than_other_objects(lit
         crop(person_photo, (186, 100, 271, 373)),  # person
     ]
     features = lite0_embedder.embed([dog, dog_again, *others])
-    assert features.shape == (6, 1280 + COLOUR_DESCRIPTOR_SIZE)
+    assert features.shape == (6, 1280 + DESCRIPTOR_SIZE)
     features = features[:, :1280]  # the backbone's part
     l1 = np.abs(features[0] - features[1:]).sum(axis=1)
     assert l1[0] < l1[1:].min(), l1
@@ -120,7 +120,7 @@ def test_batches_give_the_same_features_as_single_crops(lite0_embedder: CropEmbe
 
 
 def test_empty_and_invalid_crops(lite0_embedder: CropEmbedder) -> None:
-    assert lite0_embedder.embed([]).shape == (0, 1280 + COLOUR_DESCRIPTOR_SIZE)
+    assert lite0_embedder.embed([]).shape == (0, 1280 + DESCRIPTOR_SIZE)
     with pytest.raises(InvalidInputError, match="Crop 1"):
         lite0_embedder.embed([np.zeros((10, 10, 3), np.uint8), np.zeros((0, 10, 3), np.uint8)])
     with pytest.raises(InvalidInputError):
@@ -129,13 +129,13 @@ def test_empty_and_invalid_crops(lite0_embedder: CropEmbedder) -> None:
         EmbeddingConfig(batch_size=0)
 
 
-def test_each_embedding_ends_with_the_crops_colour_descriptor_unless_turned_off(lite0_embedder: CropEmbedder) -> None:
+def test_each_embedding_ends_with_the_crops_descriptor_unless_turned_off(lite0_embedder: CropEmbedder) -> None:
     rng = np.random.default_rng(2)
     crops = [rng.integers(0, 255, (40, 30, 3), np.uint8), np.full((25, 60, 3), (200, 30, 30), np.uint8)]
     features = lite0_embedder.embed(crops)
-    np.testing.assert_array_equal(features[:, 1280:], colour_descriptors(crops))
-    assert lite0_embedder.colour_bins == COLOUR_DESCRIPTOR_SIZE
-    assert lite0_embedder.name == f"efficientnet_lite0+colour{COLOUR_DESCRIPTOR_SIZE}"
+    np.testing.assert_array_equal(features[:, 1280:], crop_descriptors(crops))
+    assert lite0_embedder.colour_bins == DESCRIPTOR_SIZE
+    assert lite0_embedder.name == f"efficientnet_lite0+colour{DESCRIPTOR_SIZE}"
     plain = CropEmbedder(EmbeddingConfig(colour_histogram=False), backbone=lite0_embedder.backbone)
     assert plain.feature_dimension == 1280 and plain.name == "efficientnet_lite0"
     np.testing.assert_allclose(plain.embed(crops), features[:, :1280], rtol=1e-5, atol=1e-5)

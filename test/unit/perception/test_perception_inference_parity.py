@@ -31,6 +31,7 @@ from merlin2_sailor.anchoring.matching_network import NetworkMatcher  # noqa: E4
 from merlin2_sailor.anchoring.openvino_matcher import OpenVinoNetworkMatcher  # noqa: E402
 from merlin2_sailor.inference.model_cache import cache_folder  # noqa: E402
 from merlin2_sailor.inference.settings import InferenceSettings  # noqa: E402
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIZE  # noqa: E402
 from merlin2_sailor.perception.detector_registry import create_detector  # noqa: E402
 from merlin2_sailor.perception.embedding import CropEmbedder, EmbeddingConfig  # noqa: E402
 
@@ -56,7 +57,7 @@ def test_the_openvino_backbone_gives_torchs_features() -> None:
     reference = CropEmbedder(EmbeddingConfig(inference=NATIVE)).embed(crops)
     for batch_size in (1, 4, 16):
         features = CropEmbedder(EmbeddingConfig(inference=OPENVINO, batch_size=batch_size)).embed(crops)
-        assert features.shape == reference.shape == (len(crops), 1280 + 42)
+        assert features.shape == reference.shape == (len(crops), 1280 + DESCRIPTOR_SIZE)
         difference = np.abs(features - reference).max()
         assert difference <= 1e-4 * np.abs(reference).max(), (batch_size, difference)
 
@@ -70,7 +71,8 @@ def random_pairs(count: int, dimension: int, seed: int = 0) -> PairFeatures:
     time_difference = generator.uniform(0.0, 120.0, count)
     known = generator.random(count) > 0.25
     difference = np.abs(generator.normal(0.0, 0.6, (count, dimension))).astype(np.float32)
-    difference[:, -42:] = generator.uniform(0.0, 0.3, (count, 42))  # colour descriptor differences
+    # crop descriptor differences
+    difference[:, -DESCRIPTOR_SIZE:] = generator.uniform(0.0, 0.3, (count, DESCRIPTOR_SIZE))
     difference[~known] = 0.0
     return PairFeatures(
         rows=np.arange(count), columns=np.zeros(count, dtype=np.intp),
@@ -219,7 +221,7 @@ def test_the_nodes_networks_run_without_torch_once_exported(tmp_path) -> None:
     CropEmbedder(EmbeddingConfig(inference=OPENVINO))
     create_matcher(MatcherSettings(name="network", inference=OPENVINO))
     create_detector("ssd_mobilenet", {"inference": OPENVINO})
-    assert run_without_torch(str(cache_folder())) == "(1, 1322) OpenVinoNetworkMatcher 0"
+    assert run_without_torch(str(cache_folder())) == f"(1, {1280 + DESCRIPTOR_SIZE}) OpenVinoNetworkMatcher 0"
     # Nothing exported and no torch to export with: one line saying what to run.
     printed = run_without_torch(str(tmp_path / "empty"))
     assert printed.startswith("error: No exported") and "sailor export-models" in printed
