@@ -2,7 +2,7 @@
 
 Three networks, each figure beside its baseline measured in the same run on the same inputs:
 
-- crop embedding (EfficientNet-Lite0 + colour descriptor, the whole path of a percept's crop),
+- crop embedding (EfficientNet-Lite0 + crop descriptor (colour and layout), the whole path of a percept's crop),
   ms per crop at batches of 1-16: OpenVINO against torch eager (channels-last);
 - the SSD-MobileNet-v2 COCO detector, ms per frame on real photos (Debian darknet): OpenVINO
   against OpenCV DNN, both fed the same 300 px resize;
@@ -171,7 +171,7 @@ def run(quick: bool = False) -> BenchmarkResult:
     result = BenchmarkResult(
         "inference", "Inference runtime: OpenVINO vs torch / OpenCV DNN",
         f"Each network on each runtime, same inputs, median of {repeats} passes after a warm-up: crop embedding "
-        f"(16 crops of 40-300 px from the darknet photos, whole path incl. resize and colour descriptor), the "
+        f"(16 crops of 40-300 px from the darknet photos, whole path incl. resize and crop descriptor), the "
         f"SSD-MobileNet detector ({len(photos)} photos at 640x480), the matching network's heads (a frame's pairs). "
         "Threads as given per row. Memory: the anchoring service with the learned matcher, each runtime in a "
         "fresh process.",

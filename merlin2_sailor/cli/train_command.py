@@ -94,7 +94,7 @@ def run(arguments: argparse.Namespace) -> int:
     training = TrainingConfig(batch_size=arguments.batch_size, learning_rate=arguments.learning_rate,
                               seed=arguments.seed, device=arguments.device, **given)
     cache = embedding_cache(arguments, NetworkMetadata().backbone)
-    # The network reads the embeddings the cache's embedder makes, colour descriptor included.
+    # The network reads the embeddings the cache's embedder makes, crop descriptor (colour and layout) included.
     metadata = NetworkMetadata(time_scale=arguments.time_scale, feature_dimension=cache.embedder.feature_dimension,
                                colour_bins=cache.embedder.colour_bins)
     embedded = train_set.embed(cache) + validation_set.embed(cache)

@@ -4,7 +4,8 @@ The backbone's features say "a mug seen from above" so strongly that a red, a bl
 mug of one make lie closer in them than one mug seen from two sides (measured on the demo's
 house: median L1 180-230 between the red mug and its look-alikes, 208 between views of the red
 mug itself). Colour tells them apart at once, and it is what a person would use. So every crop
-embedding ends with this descriptor (see :mod:`.embedding`), and the matching network compares
+embedding ends with this descriptor, followed by the crop's layout (see :mod:`.crop_descriptor`),
+and the matching network compares
 the descriptors of a percept and an anchor as a feature of its own (see
 :mod:`merlin2_sailor.anchoring.matching_network`).
 
