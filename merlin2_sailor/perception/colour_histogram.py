@@ -28,7 +28,6 @@ does not flip between bins from one frame to the next.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 
 import cv2
 import numpy as np
@@ -142,14 +141,6 @@ def colour_descriptor(crop: np.ndarray) -> np.ndarray:
     surround = np.ones((height, width), dtype=bool)
     surround[top:bottom, left:right] = False
     return np.concatenate([colour_histogram(crop[top:bottom, left:right]), colour_histogram(crop[surround])])
-
-
-def colour_descriptors(crops: Sequence[np.ndarray]) -> np.ndarray:
-    """(N, COLOUR_DESCRIPTOR_SIZE) descriptors of N crops; an empty list gives a (0, size) array."""
-    descriptors = np.empty((len(crops), COLOUR_DESCRIPTOR_SIZE), dtype=np.float32)
-    for row, crop in enumerate(crops):
-        descriptors[row] = colour_descriptor(crop)
-    return descriptors
 
 
 def colour_similarity(descriptor_difference: np.ndarray) -> np.ndarray:

@@ -14,12 +14,12 @@ from merlin2_sailor.perception.colour_histogram import (
     HUE_BINS,
     MINIMUM_OBJECT_PIXELS,
     colour_descriptor,
-    colour_descriptors,
     colour_histogram,
     colour_similarity,
     object_colour,
     object_colour_similarity,
 )
+from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIZE, crop_descriptors
 
 
 def plain(rgb: tuple[int, int, int], size: tuple[int, int] = (20, 30)) -> np.ndarray:
@@ -94,10 +94,10 @@ def test_a_sliver_too_thin_for_a_surround_uses_the_whole_crop_for_both():
 
 def test_a_batch_is_one_descriptor_per_crop_and_bad_crops_are_refused():
     crops = [mug((220, 30, 30), 40), plain((0, 0, 255), (1, 1))]
-    batch = colour_descriptors(crops)
-    assert batch.shape == (2, COLOUR_DESCRIPTOR_SIZE)
-    np.testing.assert_array_equal(batch[1], colour_descriptor(crops[1]))
-    assert colour_descriptors([]).shape == (0, COLOUR_DESCRIPTOR_SIZE)
+    batch = crop_descriptors(crops)  # a batch of crop descriptors starts with the colour descriptors
+    assert batch.shape == (2, DESCRIPTOR_SIZE) and DESCRIPTOR_SIZE > COLOUR_DESCRIPTOR_SIZE
+    np.testing.assert_array_equal(batch[1, :COLOUR_DESCRIPTOR_SIZE], colour_descriptor(crops[1]))
+    assert crop_descriptors([]).shape == (0, DESCRIPTOR_SIZE)
     for bad in (np.zeros((0, 4, 3), np.uint8), np.zeros((4, 4), np.uint8), np.zeros((4, 4, 3), np.float32)):
         with pytest.raises(InvalidInputError, match="colour descriptor"):
             colour_descriptor(bad)
