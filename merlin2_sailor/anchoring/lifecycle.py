@@ -55,6 +55,16 @@ def was_confirmed(anchor: Anchor, config: LifecycleConfig) -> bool:
     return anchor.times_seen >= config.confirm_after
 
 
+def sightings_doubled(anchor: Anchor, config: LifecycleConfig) -> bool:
+    """Whether this sighting made the anchor's sightings twice, four times, eight times... what
+    confirmed it: when what its views say (its gallery, its colour, its place) has grown enough to
+    judge its identity again. Doubling keeps that to a few times in an anchor's life."""
+    if anchor.times_seen < 2 * config.confirm_after or anchor.times_seen % config.confirm_after:
+        return False
+    times = anchor.times_seen // config.confirm_after
+    return times & (times - 1) == 0
+
+
 def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
     """Update the state after an acquire or reacquire; True when the anchor became CONFIRMED.
 

@@ -45,7 +45,7 @@ class MatcherSettings:
     (:mod:`merlin2_sailor.perception.crop_reuse`, whose default this is).
     """
 
-    name: str = "rules"
+    name: str = "network"
     weights: str = ""
     backbone: str = DEFAULT_BACKBONE
     rules: RuleMatcherConfig = field(default_factory=RuleMatcherConfig)

@@ -210,9 +210,9 @@ SETTINGS: tuple[Setting, ...] = (
         Setting("world_frame", ("core", "world_frame"),
                 "Fixed frame the anchors live in (the percepts must be in it)."),
         Setting("matcher", ("matcher", "name"),
-                "Matching function: rules (class, distance, time; hand-tuned) or network (the learned "
-                "matching function of the paper, comparing crops too: embeds each new crop, ~4 ms on two "
-                "CPU cores with OpenVINO).", choices=tuple(sorted(MATCHER_ENTRIES))),
+                "Matching function: network (the learned matching function of the paper, comparing crops "
+                "too: embeds each new crop, ~4 ms on two CPU cores with OpenVINO) or rules (class, distance, "
+                "time; hand-tuned, no appearance: the baseline).", choices=tuple(sorted(MATCHER_ENTRIES))),
         Setting("weights", ("matcher", "weights"),
                 "Weights file of the matching network (\"\" uses the weights shipped in "
                 "merlin2_sailor/models, trained by scripts/make_default_weights.sh).", deployment=True),

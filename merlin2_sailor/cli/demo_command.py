@@ -158,6 +158,7 @@ def run_default(arguments: argparse.Namespace) -> int:
 def run_scenarios(arguments: argparse.Namespace) -> int:
     """Every requested scenario once per seed (or the soak's runs), one after another, then the
     table (and the soak's summary)."""
+    from merlin2_sailor.anchoring.matcher_registry import MatcherSettings
     from merlin2_sailor_demos.report.scenario_table import to_markdown, to_text, write_table
     from merlin2_sailor_demos.report.soak_summary import SoakSummary, write_soak
     from merlin2_sailor_demos.scenario_runner import (
@@ -179,7 +180,8 @@ def run_scenarios(arguments: argparse.Namespace) -> int:
         raise ConfigurationError(f"--deadline must be positive, got {arguments.deadline:g}")
     output = prepare_output(arguments.output)
     configured = demo_launch(output, None, RunOptions())  # what the launch's own configuration says
-    matcher = arguments.matcher or str(effective_parameter(configured, ANCHORING_NODE, "matcher") or "rules")
+    matcher = arguments.matcher or str(effective_parameter(configured, ANCHORING_NODE, "matcher")
+                                       or MatcherSettings().name)
     configured_seed = int(effective_parameter(configured, WORLD_NODE, "seed") or 0)
     first_seed = arguments.seed if arguments.seed is not None else configured_seed
     if arguments.soak:

@@ -11,7 +11,7 @@ from merlin2_sailor.anchoring import AnchorState, FusionConfig, LifecycleConfig
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.fusion import fuse_position
 from merlin2_sailor.anchoring.gallery import GALLERY_DTYPE, from_bfloat16_bits
-from merlin2_sailor.anchoring.lifecycle import after_expected_but_unseen, after_sighting, expire
+from merlin2_sailor.anchoring.lifecycle import after_expected_but_unseen, after_sighting, expire, sightings_doubled
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
 from .anchoring_scenes import SceneObject
@@ -120,6 +120,18 @@ def test_lifecycle_from_tentative_to_forgotten(maker):
     assert not after_expected_but_unseen(anchor, 3.0, config)  # already missing: no second change
     assert not expire(anchor, 11.9, config)
     assert expire(anchor, 12.0, config) and anchor.state is AnchorState.FORGOTTEN
+
+
+def test_identity_is_judged_again_each_time_the_sightings_double(maker):
+    config = LifecycleConfig(confirm_after=3)
+    anchor = new_anchor(maker)
+    judged_at = []
+    for sighting in range(2, 200):
+        anchor.absorb(maker.percept(CUP, sighting * 0.1), None, FusionConfig())
+        assert anchor.times_seen == sighting
+        if sightings_doubled(anchor, config):
+            judged_at.append(sighting)
+    assert judged_at == [6, 12, 24, 48, 96, 192]
 
 
 def test_reacquired_missing_anchor_returns_to_its_trust_level(maker):

@@ -13,6 +13,8 @@ search that goes on while the object is anchored anew.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -61,6 +63,33 @@ def search_living_room(anchoring, symbol, stamp):
 
 def kinds(result):
     return [(event.kind, event.symbol) for event in result.events]
+
+
+@pytest.mark.parametrize("turning_frames", [6, 8, 11])
+def test_a_search_judges_a_newcomer_again_as_its_views_grow(anchoring, maker, turning_frames):
+    """The moved mug is first seen in the searched room from its other side, which does not look
+    like the views its lost anchor has, then turning into view over ``turning_frames`` frames: the
+    search cannot take its new anchor when it is confirmed, but its later views look like the lost
+    mug, and the search, judging it again as its sightings double, finds it (test_merlin2_mission,
+    network, 5 December 2026: judged only once, the search gave up on a newcomer that its later
+    views showed to be the red mug)."""
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    see(anchoring, maker, [], 1.0)
+    assert search_living_room(anchoring, "cup_1", 1.5).events == ()
+    other_side, own_side = maker.appearance("the blue mug's other side"), maker.appearance("blue_mug")
+    found = None
+    for frame in range(2 * turning_frames + 4):
+        stamp = 2.0 + frame * FRAME
+        turned = min(frame / turning_frames, 1.0)
+        look = (1.0 - turned) * other_side + turned * own_side
+        percept = dataclasses.replace(maker.percept(KITCHEN_MUG, stamp, position=(1.5, 7.2, 0.8)),
+                                      embedding=(look / np.linalg.norm(look)).astype(np.float32))
+        result = anchoring.process([percept], None, stamp)
+        found = found or next((e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN), None)
+        if frame == 1:
+            assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and found is None, "taken at once"
+    assert found is not None and found.symbol == "cup_2" and found.details["reason"].endswith("it is cup_1")
+    assert anchoring.get("cup_1").state is AnchorState.CONFIRMED and len(anchoring) == 1
 
 
 def test_a_look_alike_moved_while_its_twin_stays_is_found_under_its_own_symbol(anchoring, maker):

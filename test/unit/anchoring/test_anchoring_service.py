@@ -25,7 +25,8 @@ def anchor_kitchen(service: AnchoringService, maker: PerceptMaker, frames: int, 
 
 
 def test_the_service_is_built_as_its_settings_say() -> None:
-    settings = settings_from_parameters({**OFFLINE_OVERRIDES, "confirm_after": 5, "rules_maximum_sigma": 0.4})
+    settings = settings_from_parameters({**OFFLINE_OVERRIDES, "matcher": "rules", "confirm_after": 5,
+                                         "rules_maximum_sigma": 0.4})
     service = AnchoringService(settings)
     assert service.anchoring.config is settings.core
     assert isinstance(service.matcher, RuleMatcher) and service.matcher.config.maximum_sigma == 0.4
@@ -34,8 +35,8 @@ def test_the_service_is_built_as_its_settings_say() -> None:
 
 
 def test_symbols_and_anchors_survive_a_restart_and_reach_the_knowledge_base(tmp_path, maker) -> None:
-    settings = settings_from_parameters({
-        "state_folder": str(tmp_path / "state"), "knowledge_base": f"sqlite://{tmp_path / 'kb.db'}",
+    settings = settings_from_parameters({  # the rules: these percepts carry synthetic embeddings
+        "matcher": "rules", "state_folder": str(tmp_path / "state"), "knowledge_base": f"sqlite://{tmp_path / 'kb.db'}",
         "confirm_after": 2, "sync_period": 0.05})
     with AnchoringService(settings) as service:
         anchor_kitchen(service, maker, 3)
@@ -58,7 +59,8 @@ def test_symbols_and_anchors_survive_a_restart_and_reach_the_knowledge_base(tmp_
 
 
 def test_a_crash_between_saves_never_reissues_a_symbol(tmp_path, maker) -> None:
-    settings = settings_from_parameters({"state_folder": str(tmp_path), "knowledge_base": "", "save_period": 3600.0})
+    settings = settings_from_parameters({"matcher": "rules", "state_folder": str(tmp_path), "knowledge_base": "",
+                                         "save_period": 3600.0})
     crashed = AnchoringService(settings)  # never started nor closed: its anchors were never saved
     anchor_kitchen(crashed, maker, 1)
     handed_out = {view.symbol for view in crashed.views()}
@@ -72,7 +74,7 @@ def test_a_crash_between_saves_never_reissues_a_symbol(tmp_path, maker) -> None:
 
 
 def test_views_taken_while_another_thread_anchors_are_consistent_copies(maker) -> None:
-    service = AnchoringService(settings_from_parameters(dict(OFFLINE_OVERRIDES)))
+    service = AnchoringService(settings_from_parameters({**OFFLINE_OVERRIDES, "matcher": "rules"}))
     anchor_kitchen(service, maker, 1)
     before = {view.symbol: view for view in service.views()}
     done = threading.Event()

@@ -96,14 +96,14 @@ def test_values_are_applied_generically_and_fields_checked_together_are_set_toge
     # Set one at a time, the sigmas would fail (position 1.5 above the default cap of 1.0).
     settings = settings_from_parameters({
         "rules_position_sigma": 1.5, "rules_maximum_sigma": 2.0, "forget_after": 42.0, "visible_near": 0.5,
-        "confirm_after": 5, "gate_class_mismatch": False, "matcher": "network", "world_frame": "odom",
+        "confirm_after": 5, "gate_class_mismatch": False, "matcher": "rules", "world_frame": "odom",
         "reappearance_distance": 0.1, "sync_period": 1.5,
     })
     assert (settings.matcher.rules.position_sigma, settings.matcher.rules.maximum_sigma) == (1.5, 2.0)
     assert settings.core.lifecycle == dataclasses.replace(LifecycleConfig(), forget_after=42.0, confirm_after=5)
     assert settings.core.visibility.frustum.near == 0.5 and settings.core.visibility.frustum.far == 6.0
     assert settings.core.table.gate_class_mismatch is False and settings.core.world_frame == "odom"
-    assert settings.matcher.name == "network" and settings.persistence.sync_period == 1.5
+    assert settings.matcher.name == "rules" and settings.persistence.sync_period == 1.5
     # Every other value is the default, and reading the values back gives what was set.
     values = parameter_values(settings)
     changed = {name for name, value in values.items() if value != SETTINGS_BY_NAME[name].default}
