@@ -49,7 +49,7 @@ from merlin2_sailor.anchoring.matching_table import (
     held_views,
     with_embeddings,
 )
-from merlin2_sailor.anchoring.merge import apply_decision
+from merlin2_sailor.anchoring.merge import apply_decision, withdraw_stale_ambiguities
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
@@ -277,6 +277,8 @@ class Anchoring:
             told_apart = seen | {anchor.symbol for anchor in unresolved.values()}
             check_unseen(self._index, camera, told_apart, changes, config.visibility, config.lifecycle)
         renamed = self._repair_identities(changes)
+        if changes.forgotten:
+            withdraw_stale_ambiguities(self._index)
         symbols = [renamed.get(symbol, symbol) for symbol in symbols]
         seen = {renamed.get(symbol, symbol) for symbol in seen}
         for anchor in previously_visible:
@@ -324,6 +326,8 @@ class Anchoring:
         if expectation.is_search and anchor.state is AnchorState.MISSING:
             decision = self._repair.decide_search(anchor, expectation, self._index)
             apply_decision(decision, self._index, changes, self.config.fusion)
+            if changes.forgotten:
+                withdraw_stale_ambiguities(self._index)
             if isinstance(decision, Merge):
                 return changes.result()
         anchor.expectation = expectation

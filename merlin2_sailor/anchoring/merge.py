@@ -22,6 +22,17 @@ from merlin2_sailor.anchoring.place_return import Return, trade_places
 from merlin2_sailor.anchoring.same_space import Duplicate
 
 
+def withdraw_stale_ambiguities(index: AnchorIndex) -> None:
+    """An anchor stays one that cannot be told from others only while all of them are anchors: once
+    one was merged or forgotten, the evidence has changed, and the next judgement decides afresh
+    (and says so again if they still cannot be told apart). Left standing, a stale "cannot be told
+    from cup_9, cup_12" after cup_12 proved a second anchor of cup_9's mug ended every later search
+    for the red mug unsuccessful (test_mission_end_to_end, network, 5 December 2026)."""
+    for anchor in index.missing():
+        if any(symbol not in index for symbol in anchor.indistinguishable_from):
+            anchor.indistinguishable_from = ()
+
+
 def apply_decision(
     decision: Decision | Duplicate | Return | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig
 ) -> None:
