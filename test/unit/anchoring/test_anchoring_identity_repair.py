@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 
@@ -177,3 +178,78 @@ def test_a_search_under_way_recognises_the_object_when_it_is_anchored_anew(ancho
     assert cup.state is AnchorState.CONFIRMED and cup.expectation is None
     np.testing.assert_allclose(cup.position, moved, atol=0.05)
     assert anchoring.get(green).state is AnchorState.CONFIRMED and len(anchoring) == 2
+
+
+def lost_rival_and_newcomer(maker, rival_likeness_offset: float):
+    """The red mug lost in the kitchen and sought in the living room; a green mug of the living room
+    MISSING there for a moment; a newcomer beside the green mug that looks like it (or, with a
+    ``rival_likeness_offset``, less so) and somewhat like the red mug."""
+    from merlin2_sailor.anchoring.anchor import Anchor
+    from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+    from merlin2_sailor.anchoring.fusion import FusionConfig
+    fusion = FusionConfig()
+    red = np.zeros(maker.dimension, dtype=np.float32)
+    red[0] = 1.0
+    between = red.copy()
+    between[1] = 0.65  # its look scores about 0.6 against the red mug's (the rules times likeness)
+    between /= np.linalg.norm(between)
+    green = between.copy()
+    green[2] = rival_likeness_offset
+    green /= np.linalg.norm(green)
+
+    def anchor(symbol, item, stamp, look, position=None):
+        made = Anchor.from_percept(symbol, dataclasses.replace(maker.percept(item, stamp, position=position),
+                                                               embedding=look), look, fusion)
+        made.absorb(dataclasses.replace(maker.percept(item, stamp + FRAME, position=position), embedding=look), look,
+                    fusion)
+        made.state = AnchorState.CONFIRMED
+        return made
+
+    lost = anchor("cup_1", KITCHEN_MUG, 0.0, red)
+    rival = anchor("cup_2", GREEN_MUG, 0.0, green)
+    for missing in (lost, rival):
+        missing.state, missing.lost_after, missing.missing_since = AnchorState.MISSING, missing.last_seen, 2.0
+    newcomer = anchor("cup_3", GREEN_MUG, 3.0, between, position=(2.07, 6.2, 0.8))
+    index = AnchorIndex()
+    for item in (lost, rival, newcomer):
+        index.add(item)
+    return lost, rival, newcomer, index
+
+
+@pytest.mark.parametrize(("rival_offset", "outcome"), [(0.0, None), (0.55, "undecided")],
+                         ids=["clearly the rival's", "alike"])
+def test_a_newcomer_clearly_another_lost_anchors_is_not_called_ambiguous(maker, rival_offset, outcome):
+    """A search for the red mug sees a newcomer that scores just over the threshold against it, and
+    near 1 against the green mug that went missing beside it a moment ago (a second anchor of the
+    green mug): that newcomer is the green mug's business, and nothing is decided or called
+    ambiguous for the red one (test_mission_end_to_end, network, 5 December 2026: "cannot be told
+    apart" ended the mission). Where the green mug scores no better than the red one, it stays
+    undecided."""
+    from merlin2_sailor.anchoring.identity_repair import IdentityRepair, RepairConfig, Undecided
+    lost, rival, newcomer, index = lost_rival_and_newcomer(maker, rival_offset)
+    repair = IdentityRepair(AppearanceRules(), 0.5, RepairConfig(), search_tolerance=0.5)
+    search = Expectation.at(LIVING_ROOM, 4.0, "living_room", "find", radius=1.5)
+    scores = [float(identity_scores(AppearanceRules(), [newcomer], sought, SearchedDisc(LIVING_ROOM, 2.0))[0])
+              for sought in (lost, rival)]
+    assert 0.5 <= scores[0] < 0.75, scores  # the red mug's candidate, barely
+    decision = repair.decide_search(lost, search, index)
+    if outcome is None:
+        assert scores[1] > scores[0] + 0.15, scores
+        assert decision is None
+    else:
+        assert abs(scores[1] - scores[0]) < 0.15, scores
+        assert isinstance(decision, Undecided) and decision.found == (newcomer,)
+
+
+def test_an_ambiguity_naming_an_anchor_since_forgotten_is_withdrawn(maker):
+    """The red mug could not be told from two newcomers; one of them proved a second anchor of the
+    other's object and was forgotten: what made the case undecided is gone, so the red mug is no
+    longer reported as one that cannot be told apart (the next judgement decides afresh)."""
+    from merlin2_sailor.anchoring.merge import withdraw_stale_ambiguities
+    lost, rival, newcomer, index = lost_rival_and_newcomer(maker, 0.0)
+    lost.indistinguishable_from = (rival.symbol, newcomer.symbol)
+    withdraw_stale_ambiguities(index)
+    assert lost.indistinguishable_from == (rival.symbol, newcomer.symbol)  # all still anchors: it stands
+    index.remove(newcomer.symbol)
+    withdraw_stale_ambiguities(index)
+    assert lost.indistinguishable_from == ()
