@@ -12,7 +12,9 @@ blackboard), the robot searches for it:
    though never one that a look-alike anchored there explains better), LOOKING_AROUND (stops
    early on a reacquisition) and CHECKING (wait up to ``reacquire_timeout`` for the anchor to
    be confirmed and seen since the search began; not found: the search expectation is cleared,
-   so the anchor goes back to where it was last perceived).
+   so the anchor goes back to where it was last perceived). An anchor seen since the search
+   began (on the way, from afar) is not announced anywhere, and the next stop is the waypoint
+   nearest where it was seen, once: the search ends there, not wherever the robot happened to be.
 3. On success the robot stays at that stop, and the behaviour writes ``robot_at(<stop>)``
    (DECLARED) in the knowledge base itself: the dispatcher only knows ``origin``. The anchored
    facts (``object_at``, ``missing``) are perception's to update.
@@ -75,6 +77,9 @@ class Search:
     """Each candidate anchor as it was when the search began: a sighting must be newer."""
     next_stop: int = 0
     unreachable: list[str] = field(default_factory=list)
+    sighted: list[str] = field(default_factory=list)
+    """Waypoints driven to because the sought anchor was seen near them, each once (an anchor on
+    the line between two waypoints' areas must not send the robot back and forth)."""
     indistinguishable_from: tuple[str, ...] = ()
     """Anchors the anchoring layer found and cannot tell from the sought one (look-alikes): the
     search ends there, unsuccessful, rather than claim one of them is it."""
@@ -119,12 +124,28 @@ def plan_search(state: BehaviorState, blackboard: Blackboard) -> str:
     return SUCCEED
 
 
+def seen_at(context: BehaviorContext, search: Search) -> str | None:
+    """The reachable waypoint nearest the sought anchor, if the camera has seen it since the search
+    began (on the way, from afar: a relocation while the robot drove past), else None."""
+    anchor = reacquired(context, search)
+    if anchor is None:
+        return None
+    place = context.places.nearest_waypoint(anchor.position[0], anchor.position[1])
+    return None if place is None or place in search.unreachable or place in search.sighted else place
+
+
 def next_stop(state: BehaviorState, blackboard: Blackboard) -> str:
     search: Search = blackboard[SEARCH_KEY]
-    if search.next_stop >= len(search.stops) or search.indistinguishable_from:
+    if search.indistinguishable_from:
         return EXHAUSTED
-    stop = search.stops[search.next_stop]
-    search.next_stop += 1
+    stop = seen_at(state.context, search)  # seen on the way: go where it is, not to the next stop
+    if stop is not None:
+        search.sighted.append(stop)
+    else:
+        if search.next_stop >= len(search.stops):
+            return EXHAUSTED
+        stop = search.stops[search.next_stop]
+        search.next_stop += 1
     target = place_target(state.context, stop)
     place = state.context.places.get(stop)
     if stop == search.last_place and search.last_seen is not None and place.yaw is None:
@@ -149,6 +170,9 @@ def expect_here(state: BehaviorState, blackboard: Blackboard) -> str:
     if not search.symbol:
         return SUCCEED  # a class has no anchor to move; any new anchor of it will do
     stop = blackboard[STOP_KEY]
+    if reacquired(state.context, search) is not None and (
+            stop in search.sighted or seen_at(state.context, search) not in (None, stop)):
+        return SUCCEED  # seen since the search began, by another waypoint or sent here: announcing it would move it
     last = search.last_seen
     radius = 0.0
     if last is not None and stop == search.last_place:
@@ -190,7 +214,14 @@ def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
             found.append(anchor)
         return anchor is not None
 
-    if not wait_until(seen, context.config.reacquire_timeout, context.config.poll_period, state):
+    if wait_until(seen, context.config.reacquire_timeout, context.config.poll_period, state):
+        elsewhere = seen_at(context, search)
+        if elsewhere not in (None, stop):
+            # Seen from here, but by another waypoint (the red mug, re-found in the bedroom while the
+            # robot drove to the hall, was reported "found at hall": test_mission_end_to_end).
+            context.log("info", f"{search.sought} was seen nearer {elsewhere}: going there")
+            return NOT_HERE
+    else:
         if search.symbol:
             try:
                 context.anchoring.clear_expectation(search.symbol, FIND_SOURCE)

@@ -206,3 +206,24 @@ def test_a_finished_search_can_run_again_with_a_fresh_blackboard() -> None:
     assert machine(FIND_OBJECT_ACTION.blackboard_for(("cup_1", "a"))) == ABORT
     robot.world["cup_1"] = (0.1, 0.0)
     assert machine(FIND_OBJECT_ACTION.blackboard_for(("cup_1", "a"))) == SUCCEED
+
+
+def test_find_that_sees_the_object_on_the_way_goes_to_it_and_moves_no_anchor(robot: FakeRobot) -> None:
+    """The object is seen from afar while the robot drives to its first stop (a relocation merge
+    re-finds it near c): the search announces it at no stop, so its anchor stays where it was seen,
+    and drives to c, where it ends; never "found at" a stop it was not at (test_mission_end_to_end,
+    network, 5 December 2026: the red mug, re-found in the bedroom as the robot reached the hall,
+    was announced and reported at the hall)."""
+    robot.world["cup_1"] = (5.1, 0.0)
+
+    def seen_from_afar(pose: Pose2D) -> None:
+        if (pose.x, pose.y) == WAYPOINTS["b"]:
+            robot.anchoring.see("cup_1", (5.1, 0.0, 0.8))
+
+    robot.navigation.on_arrival.insert(0, seen_from_afar)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == SUCCEED, blackboard
+    assert stops(robot) == ["b", "c"]
+    assert blackboard[FOUND_AT_KEY] == "c" and robot_locations(robot.store) == ("c",)
+    assert [e.kind for e in robot.anchoring.expectations] == []  # it was seen: nothing announced
+    assert robot.anchoring.anchors["cup_1"].position[:2] == (5.1, 0.0)
