@@ -87,6 +87,20 @@ def latest_anchors(probe, timeout: float = 20.0) -> dict[str, Anchor]:
     return {anchor.symbol: anchor for anchor in arrays[0].anchors} if arrays else {}
 
 
+def anchors_once(probe, holds, timeout: float = 20.0) -> dict[str, Anchor]:
+    """The latched anchors once ``holds`` is true of them (or the last read, at the deadline): the
+    node may still be working through the frames sent (the learned matcher embeds every crop)."""
+    latest: dict[str, Anchor] = {}
+
+    def read() -> bool:
+        nonlocal latest
+        latest = latest_anchors(probe, timeout=2.0)
+        return bool(latest) and holds(latest)
+
+    probe.wait_for(read, timeout)
+    return latest
+
+
 def test_anchoring_over_dds_with_the_knowledge_base_and_a_restart(tmp_path, ros_probe, node_process) -> None:
     namespace = f"/kb_{uuid.uuid4().hex[:8]}"
     knowledge_base = node_process("knowledge_base", "--ros-args", "-r", f"__ns:={namespace}")
@@ -100,14 +114,15 @@ def test_anchoring_over_dds_with_the_knowledge_base_and_a_restart(tmp_path, ros_
 
     for _ in range(4):  # both seen: acquired, then confirmed after three sightings
         camera.frame([CUP, BOOK])
-    anchors = latest_anchors(ros_probe)
+    anchors = anchors_once(ros_probe, lambda seen: all(
+        symbol in seen and seen[symbol].state == Anchor.STATE_CONFIRMED for symbol in ("cup_1", "book_1")))
     assert sorted(anchors) == ["book_1", "cup_1"], anchoring.text
     assert anchors["cup_1"].state == Anchor.STATE_CONFIRMED
     np.testing.assert_allclose([anchors["cup_1"].position.x, anchors["cup_1"].position.y], [3.5, 0.5], atol=0.05)
 
     for _ in range(4):  # the book is in view but no longer seen: it goes missing
         camera.frame([CUP])
-    anchors = latest_anchors(ros_probe)
+    anchors = anchors_once(ros_probe, lambda seen: "book_1" in seen and seen["book_1"].state == Anchor.STATE_MISSING)
     assert anchors["book_1"].state == Anchor.STATE_MISSING
     assert anchors["cup_1"].state == Anchor.STATE_CONFIRMED
     kinds = [(event.kind, event.symbol) for batch in events for event in batch.events]
