@@ -11,7 +11,10 @@ keeps every whole view with a colour, and asks, for each return to an object aft
   to all of the anchor's views and to its views of about the view's size only
   (``comparable_size``); and by how much the view's size differed from the anchor's typical one;
 - how often a view of *another* object of the class is ruled out (what the evidence is for), held
-  to all views and to comparable ones.
+  to all views and to comparable ones;
+- both again when a view showing clearly less of a large object than its earlier views (a part,
+  :data:`~merlin2_sailor.anchoring.partial_view.PARTIAL_FOOTPRINT_SHARE` of their median extent)
+  is no evidence, as the anchoring layer takes it.
 
 Run (needs darknet's photos for the houses' textures, as ``sailor evaluate`` does)::
 
@@ -28,7 +31,8 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import view_scale
 from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenceConfig, ColourModel, view_differs
-from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
+from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
+from merlin2_sailor.anchoring.partial_view import PARTIAL_FOOTPRINT_SHARE, PartialViewConfig, partial_views
 from merlin2_sailor_demos.identity.house_source import HouseSource
 from merlin2_sailor_demos.identity.tour import Tour, TourConfig
 from merlin2_sailor_demos.world.world import World
@@ -42,6 +46,8 @@ class ColourView:
     stamp: float
     histogram: np.ndarray
     size: float
+    extent: float
+    """The view's horizontal extent (m), the largest of its footprint's sides."""
 
 
 def whole_views(house: int, source: HouseSource) -> dict[str, list[ColourView]]:
@@ -54,7 +60,8 @@ def whole_views(house: int, source: HouseSource) -> dict[str, list[ColourView]]:
         for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
             if object_id is not None and not cut and percept.colour is not None:
                 views[f"{house}/{object_id}/{percept.class_name}"].append(
-                    ColourView(frame.stamp, np.asarray(percept.colour, dtype=np.float64), view_scale(percept)))
+                    ColourView(frame.stamp, np.asarray(percept.colour, dtype=np.float64), view_scale(percept),
+                               float(np.max(percept.size[:2]))))
     return views
 
 
@@ -78,6 +85,12 @@ def differs(earlier: list[ColourView], view: ColourView, config: ColourEvidenceC
     return view_differs(model_of(earlier), view.histogram, config)
 
 
+def a_part(earlier: list[ColourView], view: ColourView) -> bool:
+    """Whether the view shows clearly less of a large object than its earlier views did."""
+    known = float(np.median([other.extent for other in earlier]))
+    return known > SMALL_OBJECT_EXTENT and view.extent < PARTIAL_FOOTPRINT_SHARE * known
+
+
 def main(houses: int) -> int:
     config = ColourEvidenceConfig()
     source = HouseSource()
@@ -88,6 +101,7 @@ def main(houses: int) -> int:
     returns = 0
     first = {False: 0, True: 0}
     first_two = {False: 0, True: 0}
+    whole_first = whole_two = 0
     size_ratios: list[float] = []
     for views in objects.values():
         for index in range(config.minimum_views, len(views)):
@@ -100,6 +114,10 @@ def main(houses: int) -> int:
                 first[sized] += one
                 if one and index + 1 < len(views):
                     first_two[sized] += differs(earlier, views[index + 1], config, sized)
+            if not a_part(earlier, views[index]) and differs(earlier, views[index], config, True):
+                whole_first += 1
+                if index + 1 < len(views) and not a_part(earlier, views[index + 1]):
+                    whole_two += differs(earlier, views[index + 1], config, True)
             if differs(earlier, views[index], config, False):
                 typical = float(np.median([view.size for view in earlier]))
                 size_ratios.append(max(views[index].size / typical, typical / views[index].size))
@@ -107,10 +125,11 @@ def main(houses: int) -> int:
     print(f"  first view differs, held to all views: {first[False]}; to views of about its size "
           f"(x{config.comparable_size:g}): {first[True]}")
     print(f"  first two views differ: all views {first_two[False]}; comparable {first_two[True]}")
+    print(f"  comparable, and no part of a large object: first view {whole_first}, first two {whole_two}")
     if size_ratios:
         print("  size of a differing first view against the anchor's median view (times larger or smaller): "
               + ", ".join(f"{ratio:.1f}" for ratio in sorted(size_ratios)))
-    tests = ruled_all = ruled_sized = comparable = 0
+    tests = ruled_all = ruled_sized = comparable = ruled_whole = 0
     for name, views in objects.items():
         house, _, class_name = name.split("/")
         if len(views) < config.minimum_views:
@@ -126,9 +145,11 @@ def main(houses: int) -> int:
                 if near is not None and near.views >= config.minimum_views:
                     comparable += 1
                     ruled_sized += view_differs(near, view.histogram, config)
+                    ruled_whole += not a_part(views, view) and view_differs(near, view.histogram, config)
     print(f"views of another object of the class: {tests}; ruled out by all views: {ruled_all} "
           f"({100.0 * ruled_all / max(tests, 1):.0f} %); with comparable views: {comparable}, of them ruled out "
-          f"{ruled_sized} ({100.0 * ruled_sized / max(comparable, 1):.0f} %)")
+          f"{ruled_sized} ({100.0 * ruled_sized / max(comparable, 1):.0f} %), of them no part of a large object "
+          f"{ruled_whole} ({100.0 * ruled_whole / max(comparable, 1):.0f} %)")
     return 0
 
 

@@ -27,7 +27,9 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    look-alike of another colour put in its place) is gated from it, whatever the matcher scored,
    when the anchor's own views of about that view's size say so
    (:func:`~.colour_evidence.sized_view_differs`) and a first such view a moment earlier did too;
-   that first view is only held apart from the anchor (``held``).
+   that first view is only held apart from the anchor (``held``). A view is whole *for an anchor*
+   as appearance takes it (:func:`.partial_view.comparable_views`): a view showing clearly less of
+   a large object than the anchor's whole views did has a part's colour, not the object's.
 """
 
 from __future__ import annotations
@@ -233,7 +235,12 @@ class MatchingTableBuilder:
         suspected: tuple[Anchor, ...] = ()
         ruled_out = held = None
         if whole is not None:
-            ruled_out, differing, held = self._ruled_out_by_colour(percepts, anchors, whole, ~gated)
+            # Held to each anchor as appearance is: a part of a large object (a bicycle's near half,
+            # 0.59 of its 1.68 m, the rest beyond the depth) showed another colour than the whole
+            # bicycle's views and ruled its anchor out, one object under two symbols (scenario
+            # suite, `twin_moved`, network, seed 0, 5 December 2026).
+            whole_for = comparable if comparable is not None else comparable_views(columns.sizes, whole, anchors)
+            ruled_out, differing, held = self._ruled_out_by_colour(percepts, anchors, whole_for, ~gated)
             apart = ruled_out | held
             scores[apart] = self.config.gated_score
             gated |= apart
@@ -269,10 +276,11 @@ class MatchingTableBuilder:
         return rows[passing], slots[passing]
 
     def _ruled_out_by_colour(
-        self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: Sequence[bool], open_pairs: np.ndarray,
+        self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: np.ndarray, open_pairs: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(ruled out, differing, held), each (P, A): the pairs gated by colour; among them those
-        whose percept, a whole view with a colour standing in the anchor's place, differed from an
+        whose percept, a whole view (``whole``: (P, A), of the anchor's object) with a colour
+        standing in the anchor's place, differed from an
         anchor whose colour had gone unchecked for the configured absence (or was disputed
         already) and confirmed a suspicion
         a first such view raised (the others ruled out are views without a colour, far or cut
@@ -286,7 +294,7 @@ class MatchingTableBuilder:
         in_place = self._in_place(percepts, anchors)
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
-            if whole[row] and percept.colour is not None and not anchor.colour_untellable(percept, self.colour):
+            if whole[row, column] and percept.colour is not None and not anchor.colour_untellable(percept, self.colour):
                 if in_place[row, column] and anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
                         anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
                     confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
