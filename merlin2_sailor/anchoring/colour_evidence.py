@@ -84,6 +84,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from merlin2_sailor.anchoring.doubling import doubled
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 from merlin2_sailor.perception.colour_histogram import COLOUR_BINS, HUE_BINS
 
@@ -257,10 +258,7 @@ def colours_agree(first: ColourModel | None, second: ColourModel | None, config:
 def colour_evidence_grew(model: ColourModel | None, minimum_views: int) -> bool:
     """Whether the latest view made the colour known (``minimum_views`` views) or doubled its views
     since (2, 4, 8... times as many): when an identity decided on colour is worth judging again."""
-    if model is None or minimum_views <= 0 or model.views < minimum_views or model.views % minimum_views:
-        return False
-    times = model.views // minimum_views
-    return times & (times - 1) == 0
+    return model is not None and doubled(model.views, minimum_views)
 
 
 def view_differs(model: ColourModel | None, histogram: np.ndarray | None, config: ColourEvidenceConfig) -> bool:

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.doubling import doubled
 from merlin2_sailor.errors import ConfigurationError
 
 
@@ -59,10 +60,7 @@ def sightings_doubled(anchor: Anchor, config: LifecycleConfig) -> bool:
     """Whether this sighting made the anchor's sightings twice, four times, eight times... what
     confirmed it: when what its views say (its gallery, its colour, its place) has grown enough to
     judge its identity again. Doubling keeps that to a few times in an anchor's life."""
-    if anchor.times_seen < 2 * config.confirm_after or anchor.times_seen % config.confirm_after:
-        return False
-    times = anchor.times_seen // config.confirm_after
-    return times & (times - 1) == 0
+    return anchor.times_seen >= 2 * config.confirm_after and doubled(anchor.times_seen, config.confirm_after)
 
 
 def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:

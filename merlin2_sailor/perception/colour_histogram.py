@@ -33,6 +33,7 @@ import cv2
 import numpy as np
 
 from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.perception.rgb_crop import checked_rgb_crop
 
 #: Hue bins of 20 degrees each.
 HUE_BINS = 18
@@ -121,12 +122,7 @@ def object_colour_similarity(first: np.ndarray, second: np.ndarray) -> float:
 def colour_descriptor(crop: np.ndarray) -> np.ndarray:
     """(COLOUR_DESCRIPTOR_SIZE,) float32: the histogram of one (H, W, 3) uint8 RGB crop's centre,
     then of its surround (a crop too small to have both uses the whole crop for both)."""
-    crop = np.asarray(crop)
-    if crop.ndim != 3 or crop.shape[2] != 3 or crop.dtype != np.uint8 or crop.shape[0] < 1 or crop.shape[1] < 1:
-        raise InvalidInputError(
-            "A colour descriptor needs a non-empty (H, W, 3) uint8 RGB crop, "
-            f"got shape {crop.shape} and dtype {crop.dtype}."
-        )
+    crop = checked_rgb_crop(crop, "A colour descriptor")
     longest = max(crop.shape[:2])
     if longest > MAXIMUM_SIDE:
         scale = MAXIMUM_SIDE / longest

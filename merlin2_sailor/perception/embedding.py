@@ -30,11 +30,12 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from merlin2_sailor.errors import ConfigurationError, InvalidInputError
+from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.inference.settings import InferenceSettings
 from merlin2_sailor.perception.backbone import Backbone
 from merlin2_sailor.perception.backbone_registry import create_backbone
 from merlin2_sailor.perception.crop_descriptor import DESCRIPTOR_SIZE, crop_descriptors
+from merlin2_sailor.perception.rgb_crop import checked_rgb_crop
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,12 +102,7 @@ class CropEmbedder:
         size = self.backbone.input_size
         batch = np.empty((len(crops), size, size, 3), dtype=np.uint8)
         for offset, crop in enumerate(crops):
-            crop = np.asarray(crop)
-            if crop.ndim != 3 or crop.shape[2] != 3 or crop.dtype != np.uint8 or crop.shape[0] < 1 or crop.shape[1] < 1:
-                raise InvalidInputError(
-                    f"Crop {first_index + offset} must be a non-empty (H, W, 3) uint8 RGB image, "
-                    f"got shape {crop.shape} and dtype {crop.dtype}."
-                )
+            crop = checked_rgb_crop(crop, f"Crop {first_index + offset} (to embed)")
             # Area averaging when shrinking avoids aliasing; bilinear when enlarging small crops.
             shrinking = crop.shape[0] * crop.shape[1] > size * size
             interpolation = cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR

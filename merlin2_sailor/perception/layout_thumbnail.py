@@ -24,7 +24,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from merlin2_sailor.errors import InvalidInputError
+from merlin2_sailor.perception.rgb_crop import checked_rgb_crop
 
 #: Cells of the thumbnail per side.
 GRID = 6
@@ -46,12 +46,7 @@ _FLAT = 1e-3
 
 def layout_descriptor(crop: np.ndarray) -> np.ndarray:
     """(LAYOUT_SIZE,) float32 layout of one (H, W, 3) uint8 RGB crop (see the module docstring)."""
-    crop = np.asarray(crop)
-    if crop.ndim != 3 or crop.shape[2] != 3 or crop.dtype != np.uint8 or crop.shape[0] < 1 or crop.shape[1] < 1:
-        raise InvalidInputError(
-            "A layout descriptor needs a non-empty (H, W, 3) uint8 RGB crop, "
-            f"got shape {crop.shape} and dtype {crop.dtype}."
-        )
+    crop = checked_rgb_crop(crop, "A layout descriptor")
     height, width = crop.shape[:2]
     top, left = int(height * LAYOUT_MARGIN), int(width * LAYOUT_MARGIN)
     if height - 2 * top >= GRID and width - 2 * left >= GRID:
