@@ -127,7 +127,11 @@ def plan_search(state: BehaviorState, blackboard: Blackboard) -> str:
 def seen_at(context: BehaviorContext, search: Search) -> str | None:
     """The reachable waypoint nearest the sought anchor, if the camera has seen it since the search
     began (on the way, from afar: a relocation while the robot drove past), else None."""
-    anchor = reacquired(context, search)
+    return sighting_waypoint(context, search, reacquired(context, search))
+
+
+def sighting_waypoint(context: BehaviorContext, search: Search, anchor: AnchorReport | None) -> str | None:
+    """:func:`seen_at` for an anchor already asked for (None: not seen since the search began)."""
     if anchor is None:
         return None
     place = context.places.nearest_waypoint(anchor.position[0], anchor.position[1])
@@ -170,8 +174,9 @@ def expect_here(state: BehaviorState, blackboard: Blackboard) -> str:
     if not search.symbol:
         return SUCCEED  # a class has no anchor to move; any new anchor of it will do
     stop = blackboard[STOP_KEY]
-    if reacquired(state.context, search) is not None and (
-            stop in search.sighted or seen_at(state.context, search) not in (None, stop)):
+    anchor = reacquired(state.context, search)
+    if anchor is not None and (
+            stop in search.sighted or sighting_waypoint(state.context, search, anchor) not in (None, stop)):
         return SUCCEED  # seen since the search began, by another waypoint or sent here: announcing it would move it
     last = search.last_seen
     radius = 0.0

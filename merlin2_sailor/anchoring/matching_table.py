@@ -236,9 +236,9 @@ class MatchingTableBuilder:
         ruled_out = held = None
         if whole is not None:
             # Held to each anchor as appearance is: a part of a large object (a view measuring 0.59 m
-            # of a bicycle's 1.68 m) showed another colour than the whole
-            # bicycle's views and ruled its anchor out, one object under two symbols (scenario
-            # suite, `twin_moved`, network, seed 0, 5 December 2026).
+            # of a bicycle's 1.68 m) showed another colour than the whole bicycle's views and ruled
+            # its anchor out, one object under two symbols (scenario suite, `twin_moved`, network,
+            # seed 0, 5 December 2026).
             whole_for = comparable if comparable is not None else comparable_views(columns.sizes, whole, anchors)
             ruled_out, differing, held = self._ruled_out_by_colour(percepts, anchors, whole_for, ~gated)
             apart = ruled_out | held
