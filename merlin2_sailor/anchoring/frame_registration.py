@@ -31,9 +31,13 @@ scenario, half a book to the left or to the right explained six books each); col
 row's objects differ in colour and the views are close enough to measure it. The chosen offset
 is refined to the mean displacement of the percepts it explains.
 
-What it cannot do. Only whole views count as evidence (a cut view's centre is not its object's);
-the offset is then applied to every percept of the frame. Heading errors displace far objects
-more than near ones; a translation is their first-order correction within the inlier radius.
+What it cannot do. Only whole views count as evidence (a cut view's centre is not its object's),
+and a view showing clearly less of a large landmark than its whole views did is no evidence
+about that landmark (:func:`~merlin2_sailor.anchoring.partial_view.smaller_than_known`: the near
+end of a couch past a thin wall is centred up to half the couch away from it, and two or three
+such ends would read as a pose error); the offset is then applied to every percept of the frame.
+Heading errors displace far objects more than near ones; a translation is their first-order
+correction within the inlier radius.
 """
 
 from __future__ import annotations
@@ -49,6 +53,7 @@ from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs
 from merlin2_sailor.anchoring.expectation import ExpectationKind
+from merlin2_sailor.anchoring.partial_view import smaller_than_known
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 
@@ -148,8 +153,8 @@ def _candidate_pairs(
     colour: ColourEvidenceConfig,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(percept row, anchor slot, horizontal displacement anchor - percept) for every percept and
-    landmark of its class within ``maximum_offset`` horizontally whose colour the view does not
-    contradict."""
+    landmark of its class within ``maximum_offset`` horizontally of which it is not clearly a part
+    and whose colour the view does not contradict."""
     rows: list[int] = []
     slots: list[int] = []
     displacements: list[np.ndarray] = []
@@ -159,6 +164,7 @@ def _candidate_pairs(
         for slot, anchor in zip(found.tolist(), index.anchors_at(found), strict=True):
             percept = percepts[row]
             if (anchor.class_name != percept.class_name or not _is_landmark(anchor, config.minimum_views)
+                    or smaller_than_known(percept, anchor)
                     or sized_view_differs(anchor.colour_by_size, percept.colour, view_scale(percept), colour)):
                 continue
             rows.append(row)

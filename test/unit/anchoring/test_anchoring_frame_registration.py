@@ -100,6 +100,26 @@ def test_only_settled_confirmed_anchors_and_whole_views_count(maker) -> None:
     assert register_frame(percepts, index, RegistrationConfig()) is None
 
 
+@pytest.mark.parametrize("end_offset", [0.2, -0.25])
+def test_the_ends_of_large_landmarks_are_no_pose_error(maker, end_offset) -> None:
+    # Benches of a waiting room, 1.2 m long, seen whole before; now only their near ends show past
+    # a thin wall (no occluder the camera's strips see), centred end_offset along them. The three
+    # ends agree on one offset, but it is the benches' extent, not the pose: the book on its anchor
+    # must stay where it is seen.
+    benches = [SceneObject(f"bench_{i}", "bench", (3.0 + 1.0 * i, 0.0, 0.4), (0.4, 1.2, 0.8)) for i in range(3)]
+    book = SceneObject("book_0", "book", (3.0, 1.5, 0.8), (0.04, 0.16, 0.24))
+    index = settled_index([*benches, book], maker)
+    ends = [dataclasses.replace(bench, size=(0.4, 0.35, 0.8)) for bench in benches]
+    percepts = [maker.percept(end, 10.0, position=np.add(end.position, (0.0, end_offset, 0.0))) for end in ends]
+    percepts.append(maker.percept(book, 10.0))
+    assert register_frame(percepts, index, RegistrationConfig()) is None
+    # Control: whole benches seen shifted by the same amount are a pose error, found as before.
+    shifted = [maker.percept(bench, 10.0, position=np.add(bench.position, (0.0, end_offset, 0.0)))
+               for bench in benches]
+    found = register_frame(shifted, index, RegistrationConfig(maximum_offset=0.3))
+    assert found is not None and found.offset[1] == pytest.approx(-end_offset, abs=0.015)
+
+
 def test_registration_off_and_bad_settings(maker) -> None:
     books = shelf()
     index = settled_index(books, maker)
