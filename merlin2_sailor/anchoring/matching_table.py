@@ -18,8 +18,12 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    from it than from another anchor of the class (``continuation_nearest_margin``), is taken as that
    anchor's continuation: its other pairs are not scored
    (which is what spares its crop from the backbone) and the pair scores
-   ``tracker_continuity_score``. Any other continuing pair of the same class is raised to that
-   floor; a class mismatch never is;
+   ``tracker_continuity_score``; no other percept of the frame standing farther from that anchor
+   may take it (scored against the shortcut's floor, a detector's box across two books, 0.09 m
+   from one of them, outbid the book's own view for its anchor, and the book became a new
+   anchor), but one standing nearer still may (a look-alike put down beside the object, the
+   tracker handing it the object's id). Any other continuing pair of the same class is raised to
+   that floor; a class mismatch never is;
 4. **one vectorised feature computation and one matcher call** for all remaining pairs;
 5. **appearance only from comparable views**: a partial view's crop is not compared with an
    anchor's views (:func:`.partial_view.comparable_views`), nor embedded for it;
@@ -206,6 +210,10 @@ class MatchingTableBuilder:
         eligible = continuations & confirmed[np.newaxis, :] & (age <= self.config.continuation_maximum_age)
         shortcut = eligible.sum(axis=1) == 1
         gated[shortcut] = ~eligible[shortcut]
+        for row in np.flatnonzero(shortcut):  # a continued anchor is claimed from views no nearer to it
+            column = int(np.flatnonzero(eligible[row])[0])
+            apart = np.linalg.norm(columns.positions - anchor_columns.positions[column], axis=1)
+            gated[~shortcut & (apart >= apart[row]), column] = True
         continuations &= ~gated
 
         to_score = ~gated & ~shortcut[:, np.newaxis]

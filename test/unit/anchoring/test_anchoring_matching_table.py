@@ -130,6 +130,18 @@ def test_tracker_continuation_skips_scoring_and_embedding(maker):
     assert row == {"cup_1": MatchingTableConfig().tracker_continuity_score, "cup_2": MatchingTableConfig().gated_score}
 
 
+@pytest.mark.parametrize(("other_offset", "may_take_it"), [(0.09, False), (0.3, False), (0.0, True)])
+def test_a_continued_anchor_is_claimed_from_views_no_nearer_to_it(maker, other_offset, may_take_it):
+    # The continued view stands 0.02 m from its anchor; another view of the class without the id
+    # may take the anchor only when it stands nearer (the tracker may have handed the id on).
+    continued = anchor_of(maker, CUP, "cup_1", stamp=0.0, tracker_id="5")
+    view = maker.percept(moved(CUP, (0.02, 0.0, 0.0)), 0.1, tracker_id="5")
+    other = maker.percept(moved(CUP, (0.0, other_offset, 0.0)), 0.1, tracker_id="8")
+    table = MatchingTableBuilder(RuleMatcher()).build([view, other], index_of(continued))
+    assert table.shortcut.tolist() == [True, False]
+    assert table.gated[1, 0] == (not may_take_it)
+
+
 @pytest.mark.parametrize(
     ("state", "age", "class_name", "tracker_id"),
     [

@@ -282,6 +282,37 @@ def test_a_tracker_id_handed_to_a_newcomer_leaves_the_known_object_its_anchor(
     assert result.percept_symbols[0] not in ("cup_1", None)
 
 
+@pytest.mark.parametrize(("pair", "width", "partial"), [((1, 2), 0.6, True), ((2, 3), 0.5, False),
+                                                       ((3, 4), 0.45, True)])
+def test_a_box_around_two_books_never_takes_a_continued_books_anchor(make_anchoring, quick_lifecycle, maker,
+                                                                     pair, width, partial) -> None:
+    """A detector's box across two neighbouring books (a false positive of the simulated detector,
+    scenario suite, `twin_moved`, network, seed 0, 5 December 2026), in a frame where each book's
+    view continues its anchor's tracker id. Scored against the continuation's floor (0.9), the box,
+    0.09 m from a book's anchor (0.97 by the rules), took that anchor, and the book seen right on it
+    became a new anchor. Then the tracker hands one book the box's id: every book keeps its symbol."""
+    books = [SceneObject(f"book_{i}", "book", (3.0, (i - 2) * 0.18, 1.0), (0.04, 0.16, 0.24)) for i in range(5)]
+    camera = camera_view(depth=flat_depth(5.0))
+    anchoring = make_anchoring(AnchoringConfig(lifecycle=quick_lifecycle))
+    for stamp in np.arange(0.0, 2.0, 0.2):
+        anchoring.process([maker.percept(book, float(stamp), tracker_id=str(i)) for i, book in enumerate(books)],
+                          camera, float(stamp), partial=[False] * len(books))
+    symbol_of = [anchoring.find(class_name="book", near=np.array(book.position)).symbol for book in books]
+    assert len(set(symbol_of)) == len(books)
+    left, right = (books[index] for index in pair)
+    group = SceneObject("group", "book", tuple((np.add(left.position, right.position) / 2.0).tolist()),
+                        (0.1, width, 0.3))
+    percepts = [maker.percept(book, 2.0, tracker_id=str(i)) for i, book in enumerate(books)]
+    result = anchoring.process([*percepts, maker.percept(group, 2.0, tracker_id="141")], camera, 2.0,
+                               partial=[False] * (len(books) + 1))
+    assert list(result.percept_symbols[:-1]) == symbol_of
+    for stamp in np.arange(2.2, 4.2, 0.2):
+        percepts = [maker.percept(book, float(stamp), tracker_id="141" if book is left else str(i))
+                    for i, book in enumerate(books)]
+        result = anchoring.process(percepts, camera, float(stamp), partial=[partial] * len(books))
+        assert list(result.percept_symbols) == symbol_of, stamp
+
+
 def test_tracker_id_never_overrides_a_class_mismatch(maker, kitchen):
     config = AnchoringConfig(
         lifecycle=LifecycleConfig(confirm_after=1), table=MatchingTableConfig(gate_class_mismatch=False)
