@@ -94,11 +94,14 @@ def run(arguments: argparse.Namespace) -> int:
     table.update({f"{name} partial view": result.partial for name, result in pairs.items()})
     table.update({f"{name} searched": result.searched for name, result in pairs.items() if result.searched.total})
     table.update({f"{name} replaced": result.replaced for name, result in pairs.items() if result.replaced.total})
+    table.update({f"{name} as run": result.as_run for name, result in pairs.items() if built[name].uses_appearance})
     print(f"weights {weights}; split {arguments.split!r}, scenes {arguments.first}.."
           f"{arguments.first + arguments.scenes - 1}, seed {arguments.seed}, threshold {threshold:g}\n")
     print("pairs (Algorithm 3, every pair; look-alike = same class, nearer than 1 m; partial view = either "
           "side cut by the image's edge or an occluder; searched = extra pairs measured from a searched disc, "
-          "replaced = extra pairs of another object of the class where the anchor stood: only appearance tells)")
+          "replaced = extra pairs of another object of the class where the anchor stood: only appearance tells; "
+          "as run = every pair again, a partial percept scored without its look, as the anchoring layer does, "
+          "so by the rules)")
     print(format_table(table))
     print()
     for name, result in pairs.items():

@@ -134,6 +134,7 @@ class PairChunk:
     labels: np.ndarray  # (K,) bool: same physical instance
     look_alike: np.ndarray  # (K,) bool: same class and nearer than look_alike_distance
     partial: np.ndarray  # (K,) bool: the percept or the anchor's last view is a partial view
+    percept_partial: np.ndarray  # (K,) bool: the percept is, so the anchoring layer scores it without its look
     anchor_search_radii: np.ndarray  # (K,) m: the radius of a search for the anchor (0: none)
     searched: np.ndarray  # (K,) bool: a searched pair (see the module docstring), not Algorithm 3's
     replaced: np.ndarray  # (K,) bool: a replaced pair (see the module docstring), not Algorithm 3's
@@ -295,6 +296,7 @@ def _columns(scene_id: str, percepts: list[Observation], anchors: list[Observati
         labels=np.array([p.instance == a.instance for p, a in zip(percepts, anchors, strict=True)], dtype=bool),
         look_alike=(percept_classes == anchor_classes) & (distance < look_alike),
         partial=np.array([p.partial or a.partial for p, a in zip(percepts, anchors, strict=True)], dtype=bool),
+        percept_partial=np.array([p.partial for p in percepts], dtype=bool).reshape(count),
         anchor_search_radii=np.zeros(count),
         searched=np.zeros(count, dtype=bool),
         replaced=np.zeros(count, dtype=bool),

@@ -7,6 +7,7 @@ anchoring layer computes, so an evaluation measures exactly what runs on the rob
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -28,19 +29,28 @@ def chunk_features(chunk: PairChunk, matcher: Matcher, cache: EmbeddingCache | N
     return chunk.features(matcher.feature_config, embeddings)
 
 
+def as_run(features: PairFeatures, chunk: PairChunk) -> PairFeatures:
+    """The features as the anchoring layer hands them to its matcher: a partial percept's look is
+    not compared (:func:`merlin2_sailor.anchoring.partial_view.comparable_views`), so a learned
+    matcher scores that pair by its fallback rules."""
+    return dataclasses.replace(features, appearance_known=features.appearance_known & ~chunk.percept_partial)
+
+
 @dataclass(slots=True)
 class PairEvaluation:
     """Confusion counts over every pair of Algorithm 3, over its look-alike pairs (same class,
     near) and its pairs where either side is a partial view (cut by the image's edge or an
     occluder; only a source that renders whole frames, such as the house source, knows); and,
     apart, over the searched pairs and the replaced pairs (:mod:`.pair_dataset`: appearance alone
-    must tell)."""
+    must tell). ``as_run``: every pair of Algorithm 3 again, scored as the anchoring layer scores
+    it (:func:`as_run`); it differs from ``all_pairs`` only for a matcher that reads the look."""
 
     all_pairs: ConfusionCounts = field(default_factory=ConfusionCounts)
     look_alike: ConfusionCounts = field(default_factory=ConfusionCounts)
     partial: ConfusionCounts = field(default_factory=ConfusionCounts)
     searched: ConfusionCounts = field(default_factory=ConfusionCounts)
     replaced: ConfusionCounts = field(default_factory=ConfusionCounts)
+    as_run: ConfusionCounts = field(default_factory=ConfusionCounts)
 
 
 def evaluate_pairs(
@@ -49,8 +59,12 @@ def evaluate_pairs(
     """Score every chunk with ``matcher`` and count, streaming."""
     result = PairEvaluation()
     for chunk in chunks:
-        scores = matcher.score_pairs(chunk_features(chunk, matcher, cache))
+        features = chunk_features(chunk, matcher, cache)
+        scores = matcher.score_pairs(features)
         paper = ~(chunk.searched | chunk.replaced)
+        scores_as_run = matcher.score_pairs(as_run(features, chunk)) if matcher.uses_appearance else scores
+        result.as_run = result.as_run + ConfusionCounts.from_scores(chunk.labels[paper], scores_as_run[paper],
+                                                                    threshold)
         subsets = (("all_pairs", paper), ("look_alike", chunk.look_alike & paper), ("partial", chunk.partial & paper),
                    ("searched", chunk.searched), ("replaced", chunk.replaced))
         for subset, mask in subsets:

@@ -45,7 +45,7 @@ def test_train_then_evaluate_a_few_scenes(tmp_path, capsys) -> None:
     replaced = {"network replaced", "rules replaced"}
     assert set(report["pairs"]) - replaced == {"network", "rules", "network look-alike", "rules look-alike",
                                                "network partial view", "rules partial view", "network searched",
-                                               "rules searched"}
+                                               "rules searched", "network as run"}
     assert len(set(report["pairs"]) & replaced) in (0, 2)
     assert (tmp_path / "eval" / "confusion.png").is_file()
 

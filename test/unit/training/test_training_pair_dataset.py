@@ -13,6 +13,7 @@ from merlin2_sailor.anchoring.features import FeatureConfig, encode_distance
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.training.generated_scenes import Scene
 from merlin2_sailor.training.pair_dataset import REPLACED_OFFSET, PairDatasetConfig, iter_pair_chunks, scene_pairs
+from merlin2_sailor.training.pair_scoring import as_run
 
 from .conftest import hand_scene, observation
 
@@ -138,6 +139,18 @@ def test_a_known_anchor_state_is_the_anchor_side_of_its_pairs() -> None:
     assert chunk.gallery_lengths.tolist() == [1, 1, 2, 1]
     # a pair is partial when either side's view is: the partial view as percept, then as the anchor's last
     assert chunk.partial.tolist() == [True, False, True, False]
+    assert chunk.percept_partial.tolist() == [True, False, False, False]
+
+
+def test_as_run_a_partial_percepts_look_is_not_compared() -> None:
+    """The anchoring layer never compares a partial view's crop (its matcher falls back to the
+    rules for it); an evaluation "as run" hands the matcher the same features."""
+    chunk = scene_pairs(_fused_scene(), PairDatasetConfig(**ALGORITHM_3_ONLY))
+    rng = np.random.default_rng(0)
+    embeddings = (rng.random((len(chunk), 8), dtype=np.float32), rng.random((len(chunk), 8), dtype=np.float32))
+    features = chunk.features(FeatureConfig(), embeddings)
+    assert features.appearance_known.all()
+    assert as_run(features, chunk).appearance_known.tolist() == [False, True, True, True]
 
 
 def test_the_gallery_entry_nearest_the_percept_is_compared() -> None:
