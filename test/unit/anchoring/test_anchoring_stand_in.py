@@ -48,11 +48,13 @@ SCENE = (
 
 
 def run(shifts: dict[str, tuple[float, float]], glitch_frames: range, stand_in_distance: float = 0.25,
-        glitch_looks_like: str = "", seed: int = 7, missed_frames_to_missing: int = 3):
+        glitch_looks_like: str = "", seed: int = 7, missed_frames_to_missing: int = 3,
+        reappearance_distance: float = 0.25):
     """60 frames of the scene, the objects named in ``shifts`` seen off their places by those
     (x, y) offsets during ``glitch_frames``; the anchors left and the events."""
     maker = PerceptMaker(seed=seed)
-    config = AnchoringConfig(repair=RepairConfig(stand_in_distance=stand_in_distance),
+    repair = RepairConfig(stand_in_distance=stand_in_distance, reappearance_distance=reappearance_distance)
+    config = AnchoringConfig(repair=repair,
                              lifecycle=LifecycleConfig(missed_frames_to_missing=missed_frames_to_missing))
     anchoring = Anchoring(config, WidthWary())
     stamp, events = 0.0, []
@@ -77,15 +79,21 @@ def run(shifts: dict[str, tuple[float, float]], glitch_frames: range, stand_in_d
     ({"vase": (0.2, 0.08), "bottle": (0.14, -0.14)}, range(30, 35)),  # two, another way, a third of a second
 ])
 def test_a_pose_glitch_leaves_each_object_one_anchor_under_its_first_symbol(shifts, glitch):
-    anchors, events = run(shifts, glitch)
-    assert sorted((a.symbol, a.state) for a in anchors) == [
-        ("bottle_1", AnchorState.CONFIRMED), ("bowl_1", AnchorState.CONFIRMED), ("vase_1", AnchorState.CONFIRMED)]
+    first_symbols = [("bottle_1", AnchorState.CONFIRMED), ("bowl_1", AnchorState.CONFIRMED),
+                     ("vase_1", AnchorState.CONFIRMED)]
+    # The rule alone (the reappearance rule, which merges a newcomer confirmed beside an anchor as
+    # it went missing into that anchor, off):
+    anchors, events = run(shifts, glitch, reappearance_distance=0.0)
+    assert sorted((a.symbol, a.state) for a in anchors) == first_symbols
     stand_ins = [e for e in events if e.kind is AnchorEventKind.FORGOTTEN and "was away" in e.details["reason"]]
     assert len(stand_ins) == len(shifts), [e.details for e in events if e.kind is AnchorEventKind.FORGOTTEN]
     assert all(e.details["score"] >= 0.5 for e in stand_ins)
-    # Without the rule each shifted object keeps a second, MISSING anchor: the rule is what repairs it.
-    anchors, _ = run(shifts, glitch, stand_in_distance=0.0)
+    # Without either rule each shifted object keeps a second, MISSING anchor.
+    anchors, _ = run(shifts, glitch, stand_in_distance=0.0, reappearance_distance=0.0)
     assert sum(a.state is AnchorState.MISSING for a in anchors) == len(shifts)
+    # Every rule on, as by default: the same anchors, whichever rule repairs first.
+    anchors, _ = run(shifts, glitch)
+    assert sorted((a.symbol, a.state) for a in anchors) == first_symbols
 
 
 def test_an_anchor_that_never_went_missing_meanwhile_is_found_behind_its_stand_in_too():
