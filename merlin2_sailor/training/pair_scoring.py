@@ -2,7 +2,10 @@
 
 The matchers are the anchoring layer's own (:class:`~merlin2_sailor.anchoring.rule_matcher.RuleMatcher`,
 :class:`~merlin2_sailor.anchoring.matching_network.NetworkMatcher`), fed the features the
-anchoring layer computes, so an evaluation measures exactly what runs on the robot.
+anchoring layer computes. One difference is counted apart: the anchoring layer never compares
+a partial percept's look (a learned matcher then scores the pair by its fallback rules), while
+the subsets score every pair with its look, as the network was trained; ``as_run`` scores the
+pairs as the robot does.
 """
 
 from __future__ import annotations
