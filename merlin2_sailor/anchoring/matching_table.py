@@ -193,10 +193,10 @@ class MatchingTableBuilder:
         same_class = columns.class_names[:, np.newaxis] == anchor_columns.class_names[np.newaxis, :]
         continuations = tracker_continuations(columns.tracker_ids, anchor_columns.tracker_ids) & same_class & ~gated
         candidate_rows, candidate_columns = np.nonzero(continuations)
-        if candidate_rows.size:
-            distance = np.linalg.norm(
-                columns.positions[:, np.newaxis, :] - anchor_columns.positions[np.newaxis, :, :], axis=2
-            )
+        distance = np.linalg.norm(
+            columns.positions[:, np.newaxis, :] - anchor_columns.positions[np.newaxis, :, :], axis=2
+        ) if candidate_rows.size else None
+        if distance is not None:
             jump = distance[candidate_rows, candidate_columns]
             too_far = jump > self.config.continuation_maximum_distance
             # An id that lands on an object while another of its class lies clearly nearer the
@@ -210,10 +210,9 @@ class MatchingTableBuilder:
         eligible = continuations & confirmed[np.newaxis, :] & (age <= self.config.continuation_maximum_age)
         shortcut = eligible.sum(axis=1) == 1
         gated[shortcut] = ~eligible[shortcut]
-        for row in np.flatnonzero(shortcut):  # a continued anchor is claimed from views no nearer to it
-            column = int(np.flatnonzero(eligible[row])[0])
-            apart = np.linalg.norm(columns.positions - anchor_columns.positions[column], axis=1)
-            gated[~shortcut & (apart >= apart[row]), column] = True
+        if distance is not None:  # a continued anchor is claimed from views no nearer to it
+            for row, column in zip(*np.nonzero(eligible & shortcut[:, np.newaxis]), strict=True):
+                gated[~shortcut & (distance[:, column] >= distance[row, column]), column] = True
         continuations &= ~gated
 
         to_score = ~gated & ~shortcut[:, np.newaxis]
