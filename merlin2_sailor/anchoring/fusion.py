@@ -10,8 +10,9 @@ filtered by the rule that fits its noise:
 - size: an exponential moving average whose weight starts at 1/times_seen (a plain mean of the
   first measurements), then stays at ``size_smoothing``, so size can still follow a real change.
 - class: votes weighted by detector score; one misdetection cannot flip the class.
-- appearance: a gallery of the last ``gallery_size`` embeddings (:mod:`.gallery`), so the object
-  is recognised from any side it was seen from recently.
+- appearance: a gallery of ``gallery_size`` embeddings (:mod:`.gallery`), so the object is
+  recognised from any side it was seen from recently; a new view replaces the one nearest it in
+  size, so close views survive the far ones seen while the robot drives away.
 
 These are pure functions of arrays and numbers: the state lives on the anchor.
 """
@@ -33,7 +34,7 @@ class FusionConfig:
     ``drift_variance_rate`` (m^2/s): how fast uncertainty about an unseen anchor's position grows.
     ``initial_variance`` (m^2): the variance of a newly acquired anchor's position.
     ``size_smoothing``: the weight of a new size measurement once the anchor is well known.
-    ``gallery_size``: how many recent embeddings an anchor keeps.
+    ``gallery_size``: how many views' embeddings an anchor keeps.
     ``partial_view_variance_factor``: how many times less a partial view (cut by the image's edge or
     an occluder, see :mod:`.partial_view`) moves an anchor than a whole one; its centre and size
     are those of the part in view."""

@@ -298,7 +298,8 @@ SETTINGS: tuple[Setting, ...] = (
         Setting("fusion_size_smoothing", ("core", "fusion", "size_smoothing"),
                 "The weight of a new size measurement once the anchor is well known.", 0.01, 1.0),
         Setting("gallery_size", ("core", "fusion", "gallery_size"),
-                "How many recent appearance embeddings an anchor keeps.", 1, 1000),
+                "How many views' appearance embeddings an anchor keeps (a new view replaces the one "
+                "nearest in size).", 1, 1000),
         Setting("partial_view_variance_factor", ("core", "fusion", "partial_view_variance_factor"),
                 "How many times less a partial view (cut by the image's edge or an occluder) moves an "
                 "anchor than a whole one.", 1.0, 1e6),
