@@ -324,17 +324,18 @@ def test_only_a_place_can_be_searched():
 
 
 def test_a_search_finds_the_object_anchored_anew_while_it_was_missing(make_anchoring, maker, kitchen):
-    """Moved while the robot was elsewhere and seen from afar, the mug got a new anchor; the
-    search for the missing one recognises it and the mug keeps its first symbol."""
+    """Moved while the robot was elsewhere and seen from afar 3 s later (time enough to carry it
+    4 m), the mug got a new anchor; the search for the missing one recognises it and the mug keeps
+    its first symbol."""
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
     seen_twice(anchoring, maker, [cup])
     lose(anchoring, 1.0)
     elsewhere = np.array(cup.position) + (0.0, 4.0, 0.0)
     for frame in range(2):
-        anchoring.process([maker.percept(cup, 2.0 + frame * FRAME, position=elsewhere)], None, 2.0 + frame * FRAME)
+        anchoring.process([maker.percept(cup, 4.0 + frame * FRAME, position=elsewhere)], None, 4.0 + frame * FRAME)
     assert {a.symbol for a in anchoring.anchors} == {"cup_1", "cup_2"}
-    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 3.0, "bedroom", "find", radius=2.5))
+    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 5.0, "bedroom", "find", radius=2.5))
     assert {a.symbol for a in anchoring.anchors} == {"cup_1"}
     kept = anchoring.get("cup_1")
     assert kept.state is AnchorState.CONFIRMED and kept.expectation is None and kept.missing_since is None
@@ -344,7 +345,7 @@ def test_a_search_finds_the_object_anchored_anew_while_it_was_missing(make_ancho
         (AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
     assert [a.symbol for a in result.forgotten] == ["cup_2"]
     # The next percept there continues cup_1.
-    later = anchoring.process([maker.percept(cup, 3.5, position=elsewhere)], None, 3.5)
+    later = anchoring.process([maker.percept(cup, 5.5, position=elsewhere)], None, 5.5)
     assert later.percept_symbols == ("cup_1",)
 
 
@@ -359,20 +360,20 @@ def test_a_search_finds_the_newcomer_even_once_it_has_gone_missing_again(make_an
     elsewhere = np.array(cup.position) + (0.0, 4.0, 0.0)
     towards = camera_view(yaw=math.atan2(elsewhere[1], elsewhere[0]))
     for frame in range(2):
-        anchoring.process([maker.percept(cup, 2.0 + frame * FRAME, position=elsewhere)], towards, 2.0 + frame * FRAME)
+        anchoring.process([maker.percept(cup, 4.0 + frame * FRAME, position=elsewhere)], towards, 4.0 + frame * FRAME)
     frame = 0
     while anchoring.get("cup_2").state is not AnchorState.MISSING and frame < 10:
-        anchoring.process([], towards, 2.5 + frame * FRAME)  # the detector misses it
+        anchoring.process([], towards, 4.5 + frame * FRAME)  # the detector misses it
         frame += 1
     assert anchoring.get("cup_2").state is AnchorState.MISSING
-    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 3.0, "bedroom", "find", radius=2.5))
+    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 5.0, "bedroom", "find", radius=2.5))
     assert {a.symbol for a in anchoring.anchors} == {"cup_1"}
     assert [(e.kind, e.symbol) for e in result.events] == [(AnchorEventKind.FORGOTTEN, "cup_2")]
     kept = anchoring.get("cup_1")
     assert kept.state is AnchorState.MISSING and kept.expectation is None
     np.testing.assert_allclose(kept.position, elsewhere, atol=0.05)
     for frame in range(4):
-        stamp = 3.5 + frame * FRAME
+        stamp = 5.5 + frame * FRAME
         later = anchoring.process([maker.percept(cup, stamp, position=elsewhere)], towards, stamp)
         assert later.percept_symbols == ("cup_1",)
     assert anchoring.get("cup_1").state is AnchorState.CONFIRMED
@@ -392,25 +393,30 @@ def test_a_search_merges_nothing_when_the_newcomer_is_ambiguous_or_older(make_an
 def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_empty(
     make_anchoring, maker, kitchen, seen_after_the_other_mug
 ):
-    """Moved, and seen at once in the living room beside another mug, before the robot found its
-    old place empty: the newcomer is older than the missing anchor's loss, but younger than its
-    last sighting. If the other mug was first seen after that sighting too, nothing tells the two
-    apart without appearance: the search merges neither, and says so, naming both."""
+    """Moved, and seen in the living room beside another mug, before the robot found its old
+    place empty: the newcomer is older than the missing anchor's loss, but younger than its last
+    sighting. If the other mug was first seen after that sighting too (and late enough to have
+    been carried there: RepairConfig.carry_speed), nothing tells the two apart without
+    appearance: the search merges neither, and says so, naming both."""
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
-    other_mug = SceneObject("green_mug", "cup", (1.5, 5.5, 0.8))
+    other_mug = SceneObject("green_mug", "cup", (1.1, 5.3, 0.8))
+    other_seen, cup_last_in_kitchen, moved_seen = 4.0, 4.5, 9.0  # 5.7 m from the kitchen: 4.5 s apart
     seen_twice(anchoring, maker, [cup])
     for frame in range(2):  # in another room, by a camera that does not see the kitchen
-        anchoring.process([maker.percept(other_mug, 0.5 + frame * FRAME)], None, 0.5 + frame * FRAME)
+        stamp = other_seen + frame * FRAME
+        anchoring.process([maker.percept(other_mug, stamp)], None, stamp)
     if seen_after_the_other_mug:
-        anchoring.process([maker.percept(cup, 1.0)], camera_view(), 1.0)
+        anchoring.process([maker.percept(cup, cup_last_in_kitchen)], camera_view(), cup_last_in_kitchen)
     moved_to = np.array((1.5, 6.0, 0.8))
     for frame in range(2):
-        anchoring.process([maker.percept(cup, 2.0 + frame * FRAME, position=moved_to)], None, 2.0 + frame * FRAME)
-    lose(anchoring, 3.0)
+        stamp = moved_seen + frame * FRAME
+        anchoring.process([maker.percept(cup, stamp, position=moved_to)], None, stamp)
+    lose(anchoring, moved_seen + 1.0)
     assert {a.symbol: a.state for a in anchoring.anchors} == {
         "cup_1": AnchorState.MISSING, "cup_2": AnchorState.CONFIRMED, "cup_3": AnchorState.CONFIRMED}
-    result = anchoring.expect("cup_1", Expectation.at((1.5, 5.75, 0.8), 3.5, "living_room", "find", radius=1.0))
+    result = anchoring.expect("cup_1", Expectation.at((1.5, 5.75, 0.8), moved_seen + 1.5, "living_room", "find",
+                                                      radius=1.0))
     if seen_after_the_other_mug:
         assert [(e.kind, e.symbol) for e in result.events] == [
             (AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, "cup_1")]
