@@ -61,10 +61,11 @@ def add_view(
     one size are refreshed, views of other sizes stay. Keeping only the last views, an object the
     robot drove away from kept nothing but its farthest, blurred views (19-26 px boxes where the
     robot had seen it at 50); moved beside another mug and seen again from the living room at
-    27-36 px, the red mug scored 0.2-0.4 against its own anchor in every search, which therefore
-    ended "not found" with the mug in the house (scenario suite, ``moved_beside_other_colour``,
-    network, seeds 1 and 8, 5 December 2026), where runs whose anchor kept its close views scored
-    0.7. A gallery of several sizes also keeps what :mod:`.far_view` needs: views as small as a
+    27-36 px, the red mug's new anchor scored 0.25-0.39 against its own lost anchor in each of the
+    37 times a search judged it, which therefore ended "not found" with the mug in the house
+    (scenario suite, ``moved_beside_other_colour``, network, seed 8, 5 December 2026; in seed 1's
+    failure too the lost anchor held only 21-24 px views), where the runs that found it scored
+    0.69-0.74. A gallery of several sizes also keeps what :mod:`.far_view` needs: views as small as a
     far percept, once seen, stay until a view of their size replaces them. Where a size is
     unknown, the oldest view goes, as before sizes were kept."""
     kept_scales = view_scales(gallery, scales)

@@ -294,3 +294,11 @@ def test_a_look_alike_seen_too_soon_too_far_away_is_not_the_lost_object(maker, m
     merged = [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
     assert search_after(RepairConfig().carry_speed) == (merged if carried else [])
     assert search_after(0.0) == merged  # without the bound, the look decides alone: the failure fixed
+
+
+@pytest.mark.parametrize("value", [-0.5, float("nan"), float("inf")])
+def test_a_bad_carry_speed_is_refused(value):
+    from merlin2_sailor.anchoring.identity_repair import RepairConfig
+    from merlin2_sailor.errors import ConfigurationError
+    with pytest.raises(ConfigurationError, match="carry_speed"):
+        RepairConfig(carry_speed=value)
