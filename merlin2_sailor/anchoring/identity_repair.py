@@ -30,7 +30,7 @@ score at or above the match threshold, a candidate must be possible at all:
   a view of another colour in its place, its last sighting with its own colour: the colourless
   sightings after it may have been of the other object);
 - near enough to have been carried there since (``carry_speed``): an object last seen in the
-  living room is not the television the camera first sees in the bedroom two seconds later;
+  living room is not the television the camera first sees in the bedroom a second later;
 - not of another colour: the colours of the two anchors' own pixels do not rule it out
   (:mod:`.colour_evidence`; the rules have no other appearance, and the learned matcher's is
   fooled by a look-alike where the lost one stood). A mug of another colour found where the red
@@ -371,7 +371,7 @@ class IdentityRepair:
         """Whether ``lost``'s object could have got to where ``candidate`` stands in ``gap`` seconds.
 
         Born after the lost anchor's last sighting is not enough: the living room's television
-        was last seen a few seconds before the robot, in the hall, first saw the bedroom's, 5.5 m
+        was last seen 0.73 s before the robot, in the hall, first saw the bedroom's, 5.4-5.7 m
         and two doorways away; nothing else told them apart (one make; the size, turned by 90
         degrees, is no feature the matcher trusts), so a search took the bedroom's for it, and a
         television taken out of the house was reported found (probe scenario, network, seed 0,
