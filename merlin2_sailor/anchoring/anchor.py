@@ -109,6 +109,9 @@ class Anchor:
     lost_after: float | None = None
     """While MISSING: its last sighting before it went missing (later sightings while missing,
     too few to bring it back, do not count): an anchor born after it may be the object, moved."""
+    lost_at: np.ndarray | None = None
+    """While MISSING: where that sighting (``lost_after``) perceived it; a sighting while missing
+    moves ``perceived_position`` but not this (:meth:`.IdentityRepair._could_have_been_carried`)."""
     recent_sightings: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT_SIGHTINGS))
     """The stamps of its latest sightings, oldest first: whether it was seen while a newcomer beside
     it was (:mod:`.stand_in`). Not persisted: it matters for seconds."""

@@ -379,7 +379,11 @@ class IdentityRepair:
         """
         if self.config.carry_speed <= 0.0:
             return True
-        distance = float(np.linalg.norm(np.asarray(candidate.position)[:2] - np.asarray(lost.perceived_position)[:2]))
+        # Where that last sighting saw it: a sighting while missing (a false detection near the
+        # hall's doorway took the television's anchor for a frame: probe, seed 8) moves the
+        # perceived position but says nothing of where the object was.
+        last_place = lost.lost_at if lost.lost_at is not None else lost.perceived_position
+        distance = float(np.linalg.norm(np.asarray(candidate.position)[:2] - np.asarray(last_place)[:2]))
         # Each centre may be off by half its object (a part in view), and by the noise the
         # reappearance distance allows for.
         off_centre = (float(np.max(candidate.size[:2])) + float(np.max(lost.size[:2]))) / 2.0

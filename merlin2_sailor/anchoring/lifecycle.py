@@ -77,6 +77,7 @@ def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
         anchor.recovery_sightings = 0
         anchor.state = AnchorState.CONFIRMED
         anchor.lost_after = None
+        anchor.lost_at = None
         return True
     if was_confirmed(anchor, config):
         became_confirmed = anchor.state is AnchorState.TENTATIVE
@@ -120,6 +121,7 @@ def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleCon
         return False
     anchor.state = AnchorState.MISSING
     anchor.lost_after = anchor.last_seen
+    anchor.lost_at = anchor.perceived_position.copy()
     return True
 
 

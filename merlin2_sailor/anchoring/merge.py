@@ -87,6 +87,7 @@ def apply_decision(
     kept.state = AnchorState.MISSING if still_missing else AnchorState.CONFIRMED
     kept.missing_since = merged.missing_since if still_missing else None
     kept.lost_after = merged.lost_after if still_missing else None
+    kept.lost_at = merged.lost_at if still_missing else None
     kept.missed_frames = merged.missed_frames if still_missing else 0
     kept.recovery_sightings = merged.recovery_sightings if still_missing else 0
     merged.state = AnchorState.FORGOTTEN

@@ -303,3 +303,35 @@ def test_a_bad_carry_speed_is_refused(value):
     from merlin2_sailor.errors import ConfigurationError
     with pytest.raises(ConfigurationError, match="carry_speed"):
         RepairConfig(carry_speed=value)
+
+
+def test_the_bound_measures_from_where_the_lost_object_was_last_seen_before_it_went_missing(maker):
+    """A sighting while missing (too few to bring the anchor back; a false detection on the way,
+    probe scenario, seed 8) moves the anchor's perceived position, not the place its object was
+    last seen: the look-alike first seen 2 s after that, 5.5 m from it but 3 m from the false
+    sighting, is still too far to have been carried there."""
+    from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+    from merlin2_sailor.anchoring.identity_repair import IdentityRepair, RepairConfig
+    from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
+    lifecycle = LifecycleConfig(confirm_after=2, missed_frames_to_missing=1, forget_after=600.0)
+    anchoring = Anchoring(AnchoringConfig(lifecycle=lifecycle), AppearanceRules())
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    see(anchoring, maker, [], 0.5)
+    lost = anchoring.get("cup_1")
+    assert lost.state is AnchorState.MISSING
+    last_place = np.array(KITCHEN_MUG.position)
+    np.testing.assert_allclose(lost.lost_at, lost.perceived_position)
+    restored = anchor_from_dict(anchor_to_dict(lost))
+    np.testing.assert_allclose(restored.lost_at, lost.lost_at)
+    lost.perceived_position = last_place + (0.0, 2.5, 0.0)  # what a sighting while missing leaves
+    look_alike = SceneObject("look_alike", "cup", tuple(last_place + (0.0, 5.5, 0.0)), looks_like="blue_mug")
+    seen_twice(anchoring, maker, [look_alike], lost.lost_after + 2.0, camera=False)
+    candidate = anchoring.get("cup_2")
+    index = AnchorIndex()
+    for anchor in (lost, candidate):
+        index.add(anchor)
+    search = Expectation.at(candidate.position, lost.lost_after + 3.0, "bedroom", "find", radius=1.0)
+    repair = IdentityRepair(AppearanceRules(), 0.5, RepairConfig(), search_tolerance=0.5)
+    assert repair.decide_search(lost, search, index) is None
+    lost.lost_at = None  # measured from the perceived position instead, it would be taken
+    assert repair.decide_search(lost, search, index).merged is candidate
