@@ -76,8 +76,8 @@ class RepairConfig:
     move went to a look-alike (:mod:`.place_return`; 0 turns that off); ``place_review`` (s): for how long after
     a jump such a newcomer is looked for; ``carry_speed`` (m/s): how fast someone may have carried
     an object away, walking with it: a newer anchor first seen farther from where a lost one was
-    last perceived than this speed covers in the time between, plus the reappearance distance, is
-    another object (0 turns that off)."""
+    last perceived before it went missing than this speed covers in the time between (plus the
+    reappearance distance and half of each object's size) is another object (0 turns that off)."""
 
     reappearance_distance: float = 0.25
     ambiguity_margin: float = 0.15
