@@ -377,9 +377,9 @@ SETTINGS: tuple[Setting, ...] = (
                 "For how long (s) after such a jump a newcomer on the place left is looked for.", 0.0, 60.0),
         Setting("carry_speed", ("core", "repair", "carry_speed"),
                 "How fast (m/s) someone may have carried an object away, walking with it: an anchor first "
-                "seen farther from where a missing one was last perceived than this speed covers in the time "
-                "between (plus the reappearance distance) is another object, never merged into it (0 turns "
-                "that off).", 0.0, 100.0),
+                "seen farther from where a missing one was last perceived before it went missing than this "
+                "speed covers in the time between (plus the reappearance distance and half of each object's "
+                "size) is another object, never merged into it (0 turns that off).", 0.0, 100.0),
         Setting("relocation_watched_frames", ("core", "watch", "frames_to_arrive"),
                 "Frames the camera must have watched a place, with no unknown object of a class in it, for an "
                 "object of that class first seen there to count as having arrived (moved): only such an object "
