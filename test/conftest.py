@@ -13,9 +13,11 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import uuid
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -178,12 +180,31 @@ class RosProbe:
                 timeout: float = GRAPH_TIMEOUT_SECONDS) -> list[Any]:
         """Subscribe to ``topic`` and return the first ``count`` messages (fewer on timeout)."""
         received: list[Any] = []
-        subscription = self.node.create_subscription(message_type, topic, received.append, qos)
-        try:
+        with self.listener() as listener:
+            listener.create_subscription(message_type, topic, received.append, qos)
             self.wait_for(lambda: len(received) >= count, timeout)
-        finally:
-            self.node.destroy_subscription(subscription)
         return received[:count]
+
+    @contextmanager
+    def listener(self) -> Iterator[Any]:
+        """A node of its own for subscriptions a test makes and drops, spun on a thread of its own
+        and destroyed only after that thread has stopped. Not the probe's node: a subscription
+        destroyed while an executor builds its wait set raises rclpy's InvalidHandle on the
+        executor's thread and ends it, and the probe would go deaf for the rest of the test."""
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+
+        node = rclpy.create_node(f"test_listener_{uuid.uuid4().hex[:8]}", context=self.context)
+        executor = SingleThreadedExecutor(context=self.context)
+        executor.add_node(node)
+        spinning = threading.Thread(target=executor.spin, name="test-listener", daemon=True)
+        spinning.start()
+        try:
+            yield node
+        finally:
+            executor.shutdown()
+            spinning.join(timeout=5.0)
+            node.destroy_node()
 
     def close(self) -> None:
         self._spinner.close()

@@ -170,7 +170,7 @@ def when_known(ask: Callable[[], T], timeout: float) -> T:
         time.sleep(KNOWLEDGE_POLL_SECONDS)
 
 
-def place_robot(node: Any, store: KnowledgeBase, places: Places, start: str, pose_topic: str, timeout: float) -> str:
+def place_robot(store: KnowledgeBase, places: Places, start: str, pose_topic: str, timeout: float) -> str:
     """Where the knowledge base says the robot is; when it says nowhere, ``start`` or the waypoint
     nearest the robot's pose (``robot_pose``), declared.
 
@@ -185,7 +185,7 @@ def place_robot(node: Any, store: KnowledgeBase, places: Places, start: str, pos
             raise MissionError(f"--start {start!r} is not a waypoint of the map ({', '.join(places.waypoint_names())})")
         declare_robot_at(store, start)
         return start
-    pose = first_robot_pose(node, pose_topic, timeout)
+    pose = first_robot_pose(pose_topic, timeout)
     if pose is None:
         raise MissionError(f"no robot pose on {pose_topic} within {timeout:g} s and "
                            "the knowledge base does not say where the robot is; give --start WAYPOINT")
@@ -196,25 +196,27 @@ def place_robot(node: Any, store: KnowledgeBase, places: Places, start: str, pos
     return place
 
 
-def first_robot_pose(node: Any, topic: str, timeout: float) -> tuple[float, float] | None:
-    """The first robot pose heard within ``timeout`` seconds (the node spins on its own threads)."""
+def first_robot_pose(topic: str, timeout: float) -> tuple[float, float] | None:
+    """The first robot pose heard within ``timeout`` seconds.
+
+    Heard on a short-lived node of its own, never on the mission node: that node's executor spins
+    on simple_node's thread, and a subscription destroyed while that executor builds its wait set
+    raises rclpy's InvalidHandle there, which ends the thread; the mission then never hears
+    MERLIN2's result.
+    """
+    import rclpy
     from geometry_msgs.msg import PoseStamped
+    from rclpy.wait_for_message import wait_for_message
 
     from merlin2_sailor.ros.qos import SENSOR_DATA
 
-    heard: list[tuple[float, float]] = []
-    arrived = threading.Event()
-
-    def on_pose(message: PoseStamped) -> None:
-        heard.append((message.pose.position.x, message.pose.position.y))
-        arrived.set()
-
-    subscription = node.create_subscription(PoseStamped, topic, on_pose, SENSOR_DATA)
+    listener = rclpy.create_node("sailor_mission_pose_listener")
     try:
-        arrived.wait(timeout)
+        heard, message = wait_for_message(PoseStamped, listener, topic, qos_profile=SENSOR_DATA,
+                                          time_to_wait=timeout)
     finally:
-        node.destroy_subscription(subscription)
-    return heard[0] if heard else None
+        listener.destroy_node()
+    return (message.pose.position.x, message.pose.position.y) if heard else None
 
 
 def run_goals(node: Any, goals: list[Any], timeout: float) -> bool | None:
@@ -281,7 +283,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         dtos = when_known(with_kant(lambda store: goal_dtos(store, goals)), options.wait)
         logger.info(f"KANT holds what the goals name ({time.monotonic() - started:.1f} s)")
         place = when_known(with_kant(lambda store: place_robot(
-            node, store, places, options.start, options.robot_pose_topic, POSE_TIMEOUT_SECONDS)), options.wait)
+            store, places, options.start, options.robot_pose_topic, POSE_TIMEOUT_SECONDS)), options.wait)
         logger.info(f"the robot is at {place} ({time.monotonic() - started:.1f} s); goals: "
                     f"{', '.join(map(str, goals))}")
         outcome = run_goals(node, dtos, options.timeout)

@@ -153,16 +153,13 @@ class SceneCamera:
 @pytest.fixture
 def subscribe(ros_probe) -> Iterator[Callable[[Any, str], list[Any]]]:
     """Subscribe the probe to a topic for the whole test; returns the list messages arrive in."""
-    subscriptions = []
+    with ros_probe.listener() as listener:
+        def start(message_type: Any, topic: str) -> list[Any]:
+            received: list[Any] = []
+            listener.create_subscription(message_type, topic, received.append, SENSOR_DATA)
+            return received
 
-    def start(message_type: Any, topic: str) -> list[Any]:
-        received: list[Any] = []
-        subscriptions.append(ros_probe.node.create_subscription(message_type, topic, received.append, SENSOR_DATA))
-        return received
-
-    yield start
-    for subscription in subscriptions:
-        ros_probe.node.destroy_subscription(subscription)
+        yield start
 
 
 def stamp_of(message: Any) -> float:

@@ -43,20 +43,15 @@ def _wait(probe, future, timeout: float):
 def _collect_one_frame(probe) -> dict:
     """Subscribe to every camera topic at once; return the messages of the first stamp seen on all."""
     received: dict[str, dict] = {name: {} for name in CAMERA_TOPICS}
-    subscriptions = [
-        probe.node.create_subscription(kind, topic, lambda m, n=name: received[n].setdefault(_stamp(m), m),
-                                       SENSOR_DATA)
-        for name, (kind, topic) in CAMERA_TOPICS.items()
-    ]
 
     def common() -> set:
         return set.intersection(*(set(messages) for messages in received.values()))
 
-    try:
+    with probe.listener() as listener:
+        for name, (kind, topic) in CAMERA_TOPICS.items():
+            listener.create_subscription(kind, topic, lambda m, n=name: received[n].setdefault(_stamp(m), m),
+                                         SENSOR_DATA)
         probe.wait_for(lambda: bool(common()), timeout=20.0)
-    finally:
-        for subscription in subscriptions:
-            probe.node.destroy_subscription(subscription)
     stamps = common()
     assert stamps, {name: len(messages) for name, messages in received.items()}
     stamp = min(stamps)
