@@ -21,19 +21,31 @@ the threshold; from its last sighting before it went missing, 0.57.
 For a search, where the lost object is sought is a disc rather than a point: the lost anchor is
 measured from that disc (anywhere in it counts as in place), as the matching table measures a
 searched anchor; every other feature is unchanged.
+
+The mean leaves out the candidate's views too far to tell from the lost anchor's (under
+``far_view_ratio`` of the size of the lost anchor's smallest view: the criterion and the
+measurement of :mod:`.far_view`), unless the candidate has no other. A gallery keeps views of
+several sizes (:func:`.gallery.add_view`), so a candidate first seen from across a room keeps
+those far views after the robot comes close; each is a blurred copy of what the lost anchor's
+gallery saw sharp, and the network scores it low whatever the object. In the real-MERLIN2 mission
+test (CI, 5 December) the red mug carried to the bedroom was never taken for its lost anchor: its
+new anchor's one close view scored 0.75 in the searched disc and its three views of 10-18 px,
+against the lost anchor's 48-61 px, 0.30-0.53; the mean, 0.48, was under the threshold.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.far_view import smallest_view
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, pair_features
-from merlin2_sailor.anchoring.gallery import from_bfloat16_bits
+from merlin2_sailor.anchoring.gallery import from_bfloat16_bits, view_scales
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.partial_view import comparable_views
 
@@ -47,9 +59,11 @@ class SearchedDisc:
 
 
 def identity_scores(
-    matcher: Matcher, candidates: Sequence[Anchor], lost: Anchor, disc: SearchedDisc | None = None
+    matcher: Matcher, candidates: Sequence[Anchor], lost: Anchor, disc: SearchedDisc | None = None,
+    far_view_ratio: float = 0.0,
 ) -> np.ndarray:
-    """M(candidate as first perceived, lost), averaged over the candidate's views, for each
+    """M(candidate as first perceived, lost), averaged over the candidate's views comparable in size
+    with the lost anchor's (all of them when ``far_view_ratio`` is 0 or none is), for each
     candidate: a (len(candidates),) array in [0, 1]."""
     if not candidates:
         return np.zeros(0)
@@ -60,7 +74,7 @@ def identity_scores(
     sizes = np.array([anchor.size for anchor in candidates])
     comparable = (comparable_views(sizes, None, [lost])[:, 0]
                   & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0])
-    percepts, owners = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
+    percepts, owners, scales = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
     anchors = AnchorColumns.from_anchors([lost])
     if lost.lost_after is not None:
         # Its last sighting is the one before it went missing, as for who may be it at all
@@ -82,30 +96,48 @@ def identity_scores(
         with_appearance=matcher.uses_appearance,
     )
     per_view = matcher.score_pairs(features)
-    views = np.bincount(owners, minlength=len(candidates))
-    return np.bincount(owners, weights=per_view, minlength=len(candidates)) / views
+    counted = _views_counted(candidates, owners, scales, smallest_view(lost) * far_view_ratio)
+    views = np.bincount(owners, weights=counted, minlength=len(candidates))
+    return np.bincount(owners, weights=per_view * counted, minlength=len(candidates)) / views
 
 
-def score_anywhere(matcher: Matcher, candidate: Anchor, lost: Anchor) -> float:
+def score_anywhere(matcher: Matcher, candidate: Anchor, lost: Anchor, far_view_ratio: float = 0.0) -> float:
     """M(candidate, lost) with place left out (measured from a disc of radius 0 at the candidate):
     whether it is the lost object by everything but where it stands."""
-    return float(identity_scores(matcher, [candidate], lost, SearchedDisc(candidate.position, 0.0))[0])
+    return float(identity_scores(matcher, [candidate], lost, SearchedDisc(candidate.position, 0.0),
+                                 far_view_ratio)[0])
+
+
+def _views_counted(
+    candidates: Sequence[Anchor], owners: np.ndarray, scales: np.ndarray, far_below: float
+) -> np.ndarray:
+    """(rows,) 1.0 for each pseudo-percept row counted in its candidate's mean, else 0.0: rows whose
+    view is ``far_below`` pixels or larger (or of unknown size), or every row of a candidate that
+    has no such view."""
+    counted = ~(scales < far_below)  # NaN (an unknown size) compares False: counted
+    for number in range(len(candidates)):
+        rows = owners == number
+        if not counted[rows].any():
+            counted[rows] = True
+    return counted.astype(np.float64)
 
 
 def _candidates_as_percepts(
     candidates: Sequence[Anchor], with_views: np.ndarray
-) -> tuple[PerceptColumns, np.ndarray]:
+) -> tuple[PerceptColumns, np.ndarray, np.ndarray]:
     """One pseudo-percept per gallery view of each candidate (one, without embedding, if it has
     none or ``with_views`` is False for it); returns the columns and, per row, the candidate it
-    stands for."""
+    stands for and the size of its view (NaN: unknown, or no view)."""
     owners: list[int] = []
     views: list[np.ndarray | None] = []
+    sizes: list[float] = []
     for number, anchor in enumerate(candidates):
         usable = with_views[number] and anchor.gallery is not None and len(anchor.gallery)
         gallery = anchor.gallery if usable else None
         entries = [None] if gallery is None else list(from_bfloat16_bits(gallery))
         owners.extend([number] * len(entries))
         views.extend(entries)
+        sizes.extend([math.nan] if gallery is None else view_scales(gallery, anchor.gallery_scales).tolist())
     owner_array = np.asarray(owners, dtype=np.intp)
     chosen = [candidates[owner] for owner in owners]
     known = np.array([view is not None for view in views], dtype=bool)
@@ -125,4 +157,4 @@ def _candidates_as_percepts(
         embeddings=embeddings,
         has_embedding=known,
     )
-    return columns, owner_array
+    return columns, owner_array, np.asarray(sizes, dtype=np.float64)

@@ -152,7 +152,7 @@ class Anchoring:
         self._table_builder = MatchingTableBuilder(self.matcher, self.config.table, embedder, self.config.colour)
         self._repair = IdentityRepair(
             self.matcher, self.config.match_threshold, self.config.repair, self.config.expectation_tolerance,
-            self.config.colour, self.config.watch.frames_to_arrive,
+            self.config.colour, self.config.watch.frames_to_arrive, self.config.far_view.scale_ratio,
         )
         self._watched = WatchedPlaces(self.config.watch, self.config.visibility)
         self._index = AnchorIndex(self.config.index)

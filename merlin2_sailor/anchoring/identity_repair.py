@@ -149,7 +149,8 @@ class IdentityRepair:
     colour evidence configuration."""
 
     def __init__(self, matcher: Matcher, match_threshold: float, config: RepairConfig, search_tolerance: float,
-                 colour: ColourEvidenceConfig | None = None, arrival_frames: int = 0) -> None:
+                 colour: ColourEvidenceConfig | None = None, arrival_frames: int = 0,
+                 far_view_ratio: float = 0.0) -> None:
         self.matcher = matcher
         self.colour = colour or ColourEvidenceConfig()
         self.match_threshold = match_threshold
@@ -159,6 +160,15 @@ class IdentityRepair:
         self.arrival_frames = arrival_frames
         """Frames a place must have been watched for an object first seen there to have arrived
         (:mod:`.watched_places`); 0: relocation merges off."""
+        self.far_view_ratio = far_view_ratio
+        """A candidate's views under this share of the size of the lost anchor's smallest view are
+        left out of its score where it has others (:mod:`.anchor_comparison`); 0: all count."""
+
+    def _scores(self, candidates: Sequence[Anchor], lost: Anchor, disc: SearchedDisc) -> np.ndarray:
+        return identity_scores(self.matcher, candidates, lost, disc, self.far_view_ratio)
+
+    def _anywhere(self, candidate: Anchor, lost: Anchor) -> float:
+        return score_anywhere(self.matcher, candidate, lost, self.far_view_ratio)
 
     # --- searches ---------------------------------------------------------------------------
 
@@ -244,7 +254,7 @@ class IdentityRepair:
     def _decide_relocation(self, lost: Anchor, candidates: Sequence[Anchor], index: AnchorIndex) -> Merge | None:
         if not candidates:
             return None
-        scores = np.array([score_anywhere(self.matcher, candidate, lost) for candidate in candidates])
+        scores = np.array([self._anywhere(candidate, lost) for candidate in candidates])
         best = int(np.argmax(scores))
         if scores[best] < self.match_threshold:
             return None
@@ -254,7 +264,7 @@ class IdentityRepair:
         for rival in index.of_class(chosen.class_name):
             if (rival is not lost and rival.state is AnchorState.MISSING and rival.expectation is None
                     and self._relocation_possible(chosen, rival)
-                    and score_anywhere(self.matcher, chosen, rival) > scores[best] - self.config.ambiguity_margin):
+                    and self._anywhere(chosen, rival) > scores[best] - self.config.ambiguity_margin):
                 return None
         return Merge(lost, chosen, float(scores[best]), "moved: it appeared where the camera had watched", True)
 
@@ -298,7 +308,7 @@ class IdentityRepair:
         """``place_of``: where each lost anchor (``lost``, its rivals) is looked for."""
         if not candidates:
             return None
-        scores = identity_scores(self.matcher, candidates, lost, place_of(lost))
+        scores = self._scores(candidates, lost, place_of(lost))
         order = np.argsort(-scores, kind="stable")
         plausible = [int(k) for k in order if scores[k] >= self.match_threshold]
         if not plausible:
@@ -312,7 +322,7 @@ class IdentityRepair:
         chosen = candidates[best]
         rivals = self._rivals(chosen, lost, index, place_of, near_only=not moved)
         if rivals:
-            rival_scores = [float(identity_scores(self.matcher, [chosen], rival, place_of(rival))[0])
+            rival_scores = [float(self._scores([chosen], rival, place_of(rival))[0])
                             for rival in rivals]
             if max(rival_scores) >= scores[best] + self.config.ambiguity_margin:
                 # Clearly another lost anchor's object, not this one's: nothing to decide here, and
@@ -342,10 +352,10 @@ class IdentityRepair:
             others = [anchor for anchor in others if anchor.symbol in near]
         if not others:
             return []
-        own = float(identity_scores(self.matcher, [candidate], lost, place_of(lost))[0])
+        own = float(self._scores([candidate], lost, place_of(lost))[0])
         return [
             anchor for anchor in others
-            if float(identity_scores(self.matcher, [candidate], anchor, place_of(anchor))[0])
+            if float(self._scores([candidate], anchor, place_of(anchor))[0])
             > max(own - self.config.ambiguity_margin, self.match_threshold - 1e-12)
         ]
 

@@ -90,3 +90,37 @@ def test_a_lost_anchor_is_last_seen_when_it_went_missing_not_at_a_sighting_while
         assert identity_scores(TimeOnly(), [candidate], lost, disc) == pytest.approx([60.0])
     lost.lost_after = None  # back, or never lost: its latest sighting is its last
     assert identity_scores(TimeOnly(), [candidate], lost) == pytest.approx([-140.0])
+
+
+def sized(made: Anchor, sizes: list[float]) -> Anchor:
+    made.gallery_scales = np.asarray(sizes, dtype=np.float32)
+    return made
+
+
+@pytest.mark.parametrize(("lost_sizes", "candidate_sizes", "counted"), [
+    ([48.0, 61.0], [10.0, 18.0, 60.0], [False, False, True]),  # the far views of a new anchor: left out
+    ([48.0, 61.0], [23.0, 23.9, 60.0], [False, False, True]),  # just under half the smallest
+    ([48.0, 61.0], [24.0, 40.0, 60.0], [True, True, True]),  # half the smallest and over: counted
+    ([20.0, 22.0], [9.0, 18.0, 60.0], [False, True, True]),  # a lost anchor seen only from afar
+    ([48.0, 61.0], [10.0, 18.0, 20.0], [True, True, True]),  # no view comparable: every view counts
+    ([48.0, float("nan")], [10.0, 60.0], [True, True]),  # the lost anchor's sizes unknown
+    ([48.0, 61.0], [float("nan"), 60.0], [True, True]),  # a view of unknown size counts
+])
+def test_views_too_far_to_tell_from_the_lost_anchors_are_left_out_of_the_mean(lost_sizes, candidate_sizes, counted):
+    views = [[0.0, 0.0, 3.0 * k, 0.0] for k in range(len(candidate_sizes))]  # view k: 3k away
+    lost = sized(anchor("cup_1", [[0.0, 0.0, 0.0, 0.0]] * len(lost_sizes)), lost_sizes)
+    candidate = sized(anchor("cup_2", views, stamp=5.0), candidate_sizes)
+    per_view = np.exp(-3.0 * np.arange(len(candidate_sizes)))
+    expected = per_view[np.asarray(counted)].mean()
+    scores = identity_scores(AppearanceOnly(), [candidate], lost, far_view_ratio=0.5)
+    assert scores == pytest.approx([expected], rel=1e-2)
+    # Off (0), every view counts, as before.
+    assert identity_scores(AppearanceOnly(), [candidate], lost) == pytest.approx([per_view.mean()], rel=1e-2)
+
+
+def test_each_candidate_keeps_its_own_views_when_several_are_scored_at_once():
+    lost = sized(anchor("cup_1", [[0.0, 0.0]]), [50.0])
+    near_and_far = sized(anchor("cup_2", [[0.0, 0.0], [0.0, 3.0]], stamp=5.0), [60.0, 10.0])
+    only_far = sized(anchor("cup_3", [[0.0, 1.0], [0.0, 3.0]], stamp=5.0), [10.0, 12.0])
+    scores = identity_scores(AppearanceOnly(), [near_and_far, only_far], lost, far_view_ratio=0.5)
+    assert scores == pytest.approx([1.0, (np.exp(-1.0) + np.exp(-3.0)) / 2], rel=1e-2)

@@ -335,3 +335,51 @@ def test_the_bound_measures_from_where_the_lost_object_was_last_seen_before_it_w
     assert repair.decide_search(lost, search, index) is None
     lost.lost_at = None  # measured from the perceived position instead, it would be taken
     assert repair.decide_search(lost, search, index).merged is candidate
+
+
+@pytest.mark.parametrize("far_views", [2, 3, 5])
+def test_a_newcomer_first_seen_from_afar_is_judged_by_its_views_comparable_to_the_lost_ones(maker, far_views):
+    """The lost mug, seen close in the kitchen, is sought in the living room, where the robot saw it
+    first from across the room and then close: its new anchor's gallery keeps both. The far views
+    (a fifth of the size, their crops blurred: another look to the matcher) say little and are left
+    out; the close view, as the lost mug looks, decides (real-MERLIN2 mission test, CI, 5 December
+    2026: the moved mug's new anchor scored 0.75 by its close view, 0.48 over all four, and was
+    never found). A newcomer with only far views is still judged by them: it is not found on a
+    view nobody could tell."""
+    from merlin2_sailor.anchoring.anchor import Anchor
+    from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+    from merlin2_sailor.anchoring.fusion import FusionConfig
+    from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
+    from merlin2_sailor.anchoring.identity_repair import IdentityRepair, Merge, RepairConfig
+    fusion = FusionConfig()
+    look = maker.appearance(KITCHEN_MUG.identity)
+    blurred = look + np.random.default_rng(far_views).normal(scale=1.0, size=look.shape)
+    blurred /= np.linalg.norm(blurred)
+
+    def anchor(symbol, item, stamp, views, sizes, position=None):
+        made = Anchor.from_percept(symbol, maker.percept(item, stamp, position=position), None, fusion)
+        made.gallery = to_bfloat16_bits(np.asarray(views, dtype=np.float32))
+        made.gallery_scales = np.asarray(sizes, dtype=np.float32)
+        made.state = AnchorState.CONFIRMED
+        return made
+
+    lost = anchor("cup_1", KITCHEN_MUG, 0.0, [look, look], [50.0, 55.0])
+    lost.state, lost.lost_after, lost.missing_since = AnchorState.MISSING, lost.last_seen, 2.0
+    lost.lost_at = lost.position.copy()
+    moved = SceneObject("blue_mug_moved", "cup", (1.6, 6.1, 0.8), looks_like="blue_mug")
+    views, sizes = [blurred] * far_views, [10.0 + k for k in range(far_views)]
+    index = AnchorIndex()
+    for item in (lost, anchor("cup_2", moved, WALKED_THERE, [*views, look], [*sizes, 60.0])):
+        index.add(item)
+    search = Expectation.at(LIVING_ROOM, WALKED_THERE + 1.0, "living_room", "find", radius=1.5)
+
+    def decide(far_view_ratio):
+        return IdentityRepair(AppearanceRules(), 0.5, RepairConfig(), search_tolerance=0.5,
+                              far_view_ratio=far_view_ratio).decide_search(lost, search, index)
+
+    assert isinstance(decide(0.5), Merge)
+    assert decide(0.0) is None  # every view counted: the far ones outvote the close one (the failure)
+    only_far = anchor("cup_2", moved, WALKED_THERE, views, sizes)
+    index.remove("cup_2")
+    index.add(only_far)
+    assert decide(0.5) is None
