@@ -124,3 +124,15 @@ def test_each_candidate_keeps_its_own_views_when_several_are_scored_at_once():
     only_far = sized(anchor("cup_3", [[0.0, 1.0], [0.0, 3.0]], stamp=5.0), [10.0, 12.0])
     scores = identity_scores(AppearanceOnly(), [near_and_far, only_far], lost, far_view_ratio=0.5)
     assert scores == pytest.approx([1.0, (np.exp(-1.0) + np.exp(-3.0)) / 2], rel=1e-2)
+
+
+def test_a_matcher_without_appearance_scores_as_before():
+    """The rules keep no gallery and read no look: leaving far views out changes nothing for them."""
+    from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
+    lost = sized(anchor("cup_1", [[0.0, 0.0], [0.0, 0.0]]), [48.0, 61.0])
+    candidates = [sized(anchor("cup_2", [[0.0, 3.0], [0.0, 0.0]], position=(0.4, 0.0, 0.8), stamp=5.0), [10.0, 60.0]),
+                  sized(anchor("cup_3", [[0.0, 3.0]], position=(1.5, 0.0, 0.8), stamp=30.0), [9.0])]
+    for disc in (None, SearchedDisc(np.array([1.0, 0.0, 0.8]), 2.0)):
+        before = identity_scores(RuleMatcher(), candidates, lost, disc)
+        assert identity_scores(RuleMatcher(), candidates, lost, disc, far_view_ratio=0.5) == pytest.approx(before)
+        assert (before > 0.0).all()
