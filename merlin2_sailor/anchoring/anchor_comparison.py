@@ -115,11 +115,8 @@ def _views_counted(
     view is ``far_below`` pixels or larger (or of unknown size), or every row of a candidate that
     has no such view."""
     counted = ~(scales < far_below)  # NaN (an unknown size) compares False: counted
-    for number in range(len(candidates)):
-        rows = owners == number
-        if not counted[rows].any():
-            counted[rows] = True
-    return counted.astype(np.float64)
+    has_near_view = np.bincount(owners, weights=counted, minlength=len(candidates)) > 0
+    return (counted | ~has_near_view[owners]).astype(np.float64)
 
 
 def _candidates_as_percepts(
