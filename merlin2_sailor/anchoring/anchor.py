@@ -11,8 +11,10 @@ callers read them. Fusion rules live in :mod:`.fusion`, lifecycle rules in :mod:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 
@@ -24,6 +26,7 @@ from merlin2_sailor.anchoring.colour_evidence import (
     ColourModel,
     combined,
     combined_by_size,
+    comparable_views_of,
     with_sized_view,
     with_view,
 )
@@ -54,6 +57,26 @@ class AnchorState(Enum):
 def view_scale(percept: Percept) -> float:
     """The size of a view in pixels: the square root of its box's area (0 for an empty box)."""
     return math.sqrt(max(percept.box.width, 0.0) * max(percept.box.height, 0.0))
+
+
+def view_bearing(percept: Percept) -> float | None:
+    """The horizontal direction (radians, world frame) from the object to the camera that saw
+    it, or None when the camera's position is not known (or stands right above it)."""
+    if percept.viewpoint is None:
+        return None
+    dx = float(percept.viewpoint[0] - percept.position[0])
+    dy = float(percept.viewpoint[1] - percept.position[1])
+    if not (math.isfinite(dx) and math.isfinite(dy)) or math.hypot(dx, dy) < 1e-6:
+        return None
+    return math.atan2(dy, dx)
+
+
+def seen_from(percepts: Sequence[Percept], camera_position: np.ndarray) -> tuple[Percept, ...]:
+    """The percepts, each with ``camera_position`` (world frame) as its viewpoint unless it has one."""
+    viewpoint = np.array(camera_position, dtype=np.float64).reshape(3)
+    viewpoint.setflags(write=False)
+    return tuple(percept if percept.viewpoint is not None else dataclasses.replace(percept, viewpoint=viewpoint)
+                 for percept in percepts)
 
 
 def _zero_vector() -> np.ndarray:
@@ -161,7 +184,8 @@ class Anchor:
             position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
             whole_views=0 if partial else 1,
             colour=None if partial else with_view(None, percept.colour),
-            colour_by_size=None if partial else with_sized_view(None, percept.colour, view_scale(percept)),
+            colour_by_size=None if partial else with_sized_view(None, percept.colour, view_scale(percept),
+                                                                  view_bearing(percept)),
             colour_seen=None if partial or percept.colour is None else percept.stamp,
             visible=True,
             perceived_position=position.copy(),
@@ -192,7 +216,8 @@ class Anchor:
             self.whole_views += 1
             self.size = fuse_size(self.size, percept.size, self.whole_views, config)
             self.colour = with_view(self.colour, percept.colour)
-            self.colour_by_size = with_sized_view(self.colour_by_size, percept.colour, view_scale(percept))
+            self.colour_by_size = with_sized_view(self.colour_by_size, percept.colour, view_scale(percept),
+                                                  view_bearing(percept))
             if percept.colour is not None:
                 self.colour_seen = percept.stamp
                 self.colour_disputed = False
@@ -251,14 +276,14 @@ class Anchor:
 
     def colour_untellable(self, percept: Percept, config: ColourEvidenceConfig) -> bool:
         """Whether the anchor knows its colour (``minimum_views`` whole views) but has too few views
-        of about the percept's size to hold the percept's colour to: such a view's colour says
-        nothing for or against it, as if it had none (a far view of the green mug standing where
-        the red one was seen only close up must neither rule the red anchor out nor be fused into
-        its colour)."""
+        of about the percept's size, seen from about its side, to hold the percept's colour to: such
+        a view's colour says nothing for or against it, as if it had none (a far view of the green
+        mug standing where the red one was seen only close up must neither rule the red anchor out
+        nor be fused into its colour)."""
         if config.minimum_views == 0 or self.colour is None or self.colour.views < config.minimum_views:
             return False
-        near = None if self.colour_by_size is None else self.colour_by_size.comparable(view_scale(percept),
-                                                                                     config.comparable_size)
+        near = None if self.colour_by_size is None else comparable_views_of(
+            self.colour_by_size, view_scale(percept), view_bearing(percept), config)
         return near is None or near.views < config.minimum_views
 
     @property

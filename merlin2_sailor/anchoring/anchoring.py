@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, seen_from
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex, IndexConfig
 from merlin2_sailor.anchoring.assignment import assign
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colour_evidence_grew
@@ -206,6 +206,8 @@ class Anchoring:
         caller that knows (a replay of generated scenes, whose renderer says so); by default it is
         told from the camera (:func:`.partial_view.partial_views`)."""
         check_percepts(percepts, stamp, self.config.world_frame)
+        if camera is not None:
+            percepts = seen_from(percepts, camera.position)
         if partial is not None and len(partial) != len(percepts):
             raise InvalidInputError(f"{len(partial)} partial-view flags for {len(percepts)} percepts.")
         changes = FrameChanges(stamp)

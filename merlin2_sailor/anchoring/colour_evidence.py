@@ -62,6 +62,18 @@ the mission claimed the green mug (`swapped`, rules, seed 0). While the colour i
 every size join it, so an object approached fills its sizes in. Merges compare two anchors' whole
 models, as before: their means over many views are not one view.
 
+A single view is also held only to the anchor's views *from about its side* (``comparable_bearing``:
+the views whose bearing, the horizontal direction from the object to the camera, lies within that
+many degrees of the view's, kept by sectors of 45 degrees). Why: an object's colour is not the
+same from every side (a dog's flank and its face, a bird's back and its breast, the front and
+the back of anything printed), and a view from a side the anchor never saw is no evidence that
+it is another object. Measured in the scenario suite's probes of 5 December 2026: a large
+many-coloured object seen again from another side (the kitchen's dog, the living room's bird, the
+bedroom's dog) had its view ruled out by colour 0.03-0.05 m from its own anchor, and got a
+second anchor. A look-alike put in an object's place is seen from where the object was seen (the
+robot comes back by the same waypoints), so it is still ruled out. A view whose bearing is not
+known (no camera pose) is held to all sides, as before.
+
 Only a view standing in the anchor's place (within ``place_radius``, 0.5 m, and nearer to it than
 to any other anchor of its class: on a shelf, a book's view is not its neighbour's) counts against it: the
 matching table's gate reaches 3 m or more, and a view of the hall's book 3 m from the kitchen's
@@ -105,7 +117,9 @@ class ColourEvidenceConfig:
     ``second_view_after`` (s): how long after a first view of another colour a second one must
     come before they rule the anchor out (0: the first one does); ``place_radius`` (m): how near
     (horizontally) to the anchor a single view must stand for its colour to count against it
-    (nearer to no other anchor of its class, too)."""
+    (nearer to no other anchor of its class, too); ``comparable_bearing`` (degrees): how far the
+    bearings of the anchor's views (object to camera, horizontally) may be from a single view's
+    (180: every side)."""
 
     minimum_views: int = 3
     minimum_difference: float = 0.1
@@ -114,6 +128,7 @@ class ColourEvidenceConfig:
     comparable_size: float = 2.0
     second_view_after: float = 0.3
     place_radius: float = 0.5
+    comparable_bearing: float = 60.0
 
     def __post_init__(self) -> None:
         if self.minimum_views < 0:
@@ -134,6 +149,10 @@ class ColourEvidenceConfig:
             )
         if not (math.isfinite(self.place_radius) and self.place_radius > 0.0):
             raise ConfigurationError(f"anchoring colour_place_radius must be > 0 metres, got {self.place_radius}.")
+        if not (math.isfinite(self.comparable_bearing) and 0.0 < self.comparable_bearing <= 180.0):
+            raise ConfigurationError(
+                f"anchoring colour_comparable_bearing must be in (0, 180] degrees, got {self.comparable_bearing}."
+            )
         if not (math.isfinite(self.second_view_after) and self.second_view_after >= 0.0):
             raise ConfigurationError(
                 f"anchoring colour_second_view_after must be >= 0 seconds, got {self.second_view_after}."
@@ -269,6 +288,8 @@ def view_differs(model: ColourModel | None, histogram: np.ndarray | None, config
 
 #: Bands of view sizes per octave (each band spans a factor of the square root of 2).
 SIZE_BANDS_PER_OCTAVE = 2
+#: Sectors of bearing (object to camera, horizontally) around an object: 45 degrees each.
+BEARING_SECTORS = 8
 
 
 def size_band(size: float) -> int:
@@ -281,32 +302,62 @@ def band_centre(band: int) -> float:
     return 2.0 ** ((band + 0.5) / SIZE_BANDS_PER_OCTAVE)
 
 
+def bearing_sector(bearing: float | None) -> int | None:
+    """The sector of a bearing in radians (None, or not finite: not known)."""
+    if bearing is None or not math.isfinite(bearing):
+        return None
+    return math.floor((bearing % math.tau) / (math.tau / BEARING_SECTORS)) % BEARING_SECTORS
+
+
+def sector_centre(sector: int) -> float:
+    """The middle of a sector's bearings, in radians."""
+    return (sector + 0.5) * math.tau / BEARING_SECTORS
+
+
+def bearing_gap(first: float, second: float) -> float:
+    """The angle between two bearings, in radians (0..pi)."""
+    gap = abs(first - second) % math.tau
+    return min(gap, math.tau - gap)
+
+
+ViewKey = tuple[int, int | None]
+"""(size band, bearing sector or None where the bearing was not known)."""
+
+
 @dataclass(slots=True, eq=False)
 class ColourBySize:
-    """An anchor's whole views' colours, one :class:`ColourModel` per band of view sizes, so that a
-    single view is held only to views of about its size (see the module docstring). Bounded: a
-    view 64 pixels or 1,000 pixels across adds to one of a few dozen bands, never a new entry each."""
+    """An anchor's whole views' colours, one :class:`ColourModel` per band of view sizes and sector
+    of bearings, so that a single view is held only to views of about its size, seen from about
+    its side (see the module docstring). Bounded: a view adds to one of a few dozen bands times
+    eight sectors, never a new entry each."""
 
-    bands: dict[int, ColourModel] = field(default_factory=dict)
+    bands: dict[ViewKey, ColourModel] = field(default_factory=dict)
 
-    def add(self, histogram: np.ndarray, size: float) -> None:
-        """One more whole view's colour; a view without a size (an empty box) has no band and is left out."""
+    def add(self, histogram: np.ndarray, size: float, bearing: float | None = None) -> None:
+        """One more whole view's colour; a view without a size (an empty box) has no band and is
+        left out; ``bearing`` (radians, object to camera): None where not known."""
         if not (math.isfinite(size) and size > 0.0):
             return
-        band = size_band(size)
-        model = self.bands.get(band)
+        key = (size_band(size), bearing_sector(bearing))
+        model = self.bands.get(key)
         if model is None:
-            self.bands[band] = ColourModel.of(histogram)
+            self.bands[key] = ColourModel.of(histogram)
         else:
             model.add(histogram)
 
-    def comparable(self, size: float, ratio: float) -> ColourModel | None:
-        """The views whose band's middle is at most ``ratio`` times larger or smaller than ``size``,
-        as one model (None: none)."""
+    def comparable(self, size: float, ratio: float, bearing: float | None = None,
+                   bearing_window: float = 180.0) -> ColourModel | None:
+        """The views whose band's middle is at most ``ratio`` times larger or smaller than ``size``
+        and, where both bearings are known, whose sector's middle is at most ``bearing_window``
+        degrees from ``bearing``, as one model (None: none)."""
         if not (math.isfinite(size) and size > 0.0):
             return None
-        chosen = [model for band, model in sorted(self.bands.items())
-                  if size / ratio <= band_centre(band) <= size * ratio]
+        window = math.radians(bearing_window)
+        known = bearing is not None and math.isfinite(bearing)
+        ordered = sorted(self.bands.items(), key=lambda item: view_key_order(item[0]))
+        chosen = [model for (band, sector), model in ordered
+                  if size / ratio <= band_centre(band) <= size * ratio
+                  and (not known or sector is None or bearing_gap(sector_centre(sector), bearing) <= window)]
         if not chosen:
             return None
         result = chosen[0].copy()
@@ -316,18 +367,38 @@ class ColourBySize:
 
     def merged(self, other: ColourBySize) -> ColourBySize:
         """Both anchors' views, band by band (an anchor merged into another)."""
-        bands = {band: model.copy() for band, model in self.bands.items()}
-        for band, model in other.bands.items():
-            bands[band] = bands[band].merged(model) if band in bands else model.copy()
+        bands = {key: model.copy() for key, model in self.bands.items()}
+        for key, model in other.bands.items():
+            bands[key] = bands[key].merged(model) if key in bands else model.copy()
         return ColourBySize(bands)
 
 
-def with_sized_view(model: ColourBySize | None, histogram: np.ndarray | None, size: float) -> ColourBySize | None:
-    """``model`` after one more whole view's colour, seen ``size`` pixels large (None: no colour)."""
+def view_key_order(key: ViewKey) -> tuple[int, int]:
+    """Bands in a fixed order (sums in a fixed order: the same result on every run)."""
+    band, sector = key
+    return band, -1 if sector is None else sector
+
+
+def view_key_text(key: ViewKey) -> str:
+    """A snapshot's name for a band: ``"10"`` (bearing not known) or ``"10/3"``."""
+    band, sector = key
+    return str(band) if sector is None else f"{band}/{sector}"
+
+
+def view_key_from_text(text: str) -> ViewKey:
+    """The band :func:`view_key_text` named (a snapshot written before bearings has sizes only)."""
+    band, _, sector = str(text).partition("/")
+    return int(band), int(sector) if sector else None
+
+
+def with_sized_view(model: ColourBySize | None, histogram: np.ndarray | None, size: float,
+                    bearing: float | None = None) -> ColourBySize | None:
+    """``model`` after one more whole view's colour, seen ``size`` pixels large from ``bearing``
+    (None: no colour)."""
     if histogram is None:
         return model
     model = model if model is not None else ColourBySize()
-    model.add(histogram, size)
+    model.add(histogram, size, bearing)
     return model
 
 
@@ -340,10 +411,17 @@ def combined_by_size(first: ColourBySize | None, second: ColourBySize | None) ->
 
 
 def sized_view_differs(model: ColourBySize | None, histogram: np.ndarray | None, size: float,
-                       config: ColourEvidenceConfig) -> bool:
-    """Whether one whole view's colour, seen ``size`` pixels large, shows it is not the anchor's
-    object: it differs from the anchor's views of about its size (``comparable_size``), of which
-    there must be ``minimum_views`` (fewer: nothing to tell by, so nothing is ruled out)."""
+                       config: ColourEvidenceConfig, bearing: float | None = None) -> bool:
+    """Whether one whole view's colour, seen ``size`` pixels large from ``bearing``, shows it is
+    not the anchor's object: it differs from the anchor's views of about its size
+    (``comparable_size``) and side (``comparable_bearing``), of which there must be
+    ``minimum_views`` (fewer: nothing to tell by, so nothing is ruled out)."""
     if histogram is None or model is None:
         return False
-    return view_differs(model.comparable(size, config.comparable_size), histogram, config)
+    return view_differs(comparable_views_of(model, size, bearing, config), histogram, config)
+
+
+def comparable_views_of(model: ColourBySize, size: float, bearing: float | None,
+                        config: ColourEvidenceConfig) -> ColourModel | None:
+    """The anchor's views a single view of ``size`` pixels, seen from ``bearing``, is held to."""
+    return model.comparable(size, config.comparable_size, bearing, config.comparable_bearing)

@@ -49,7 +49,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_scale
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_bearing, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs
 from merlin2_sailor.anchoring.expectation import ExpectationKind
@@ -165,7 +165,8 @@ def _candidate_pairs(
             percept = percepts[row]
             if (anchor.class_name != percept.class_name or not _is_landmark(anchor, config.minimum_views)
                     or smaller_than_known(percept, anchor)
-                    or sized_view_differs(anchor.colour_by_size, percept.colour, view_scale(percept), colour)):
+                    or sized_view_differs(anchor.colour_by_size, percept.colour, view_scale(percept), colour,
+                                          view_bearing(percept))):
                 continue
             rows.append(row)
             slots.append(slot)

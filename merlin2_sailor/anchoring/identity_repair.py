@@ -42,7 +42,9 @@ anchor, *and* the lost anchor is clearly the best of every other MISSING anchor 
 could be: two missing look-alike mugs and one mug found cannot be told apart, and then the
 decision is :class:`Undecided`, naming the candidates, instead of a guess. A candidate clearly
 better explained by another MISSING anchor (by the margin) is that anchor's business: nothing is
-decided for the lost one, and nothing is ambiguous either.
+decided for the lost one, and nothing is ambiguous either. And a search's find where the camera
+had never watched before it appeared is :class:`Undecided` when the robot knows a twin of the
+lost object: it may be another twin that was there all along (:meth:`IdentityRepair.decide_search`).
 """
 
 from __future__ import annotations
@@ -183,7 +185,39 @@ class IdentityRepair:
             if self._possible(anchor, sought, include_missing=True)
             and float(np.linalg.norm(anchor.position[:2] - disc.centre[:2])) <= reach
         ]
-        return self._decide(sought, candidates, index, lambda _: disc, reason="found by search", moved=True)
+        decision = self._decide(sought, candidates, index, lambda _: disc, reason="found by search", moved=True)
+        return self._unless_a_twin_stood_there(decision, index) if isinstance(decision, Merge) else decision
+
+    def _unless_a_twin_stood_there(self, merge: Merge, index: AnchorIndex) -> Decision:
+        """The search's merge, or :class:`Undecided` when its candidate may be another look-alike of
+        the sought object that stood there all along.
+
+        A search finds an anchor that looks like the lost one, in the disc; it cannot know whether
+        that is the lost object, moved there, or a look-alike of it that was always there. Where the
+        camera had watched the candidate's place before it appeared (:mod:`.watched_places`), it
+        arrived: that is evidence it moved there. Where it had not (a room the robot never looked
+        into), the look is the only evidence, and a look is shared by every twin: when the robot
+        knows a twin of the lost object (another anchor whose colour agrees with the lost one's,
+        both known, and that the matching function takes for it, place left out), the look is
+        known not to single the lost object out. Measured: a blue book taken off a shelf, beside
+        its identical twin, was reported found as the identical blue book on the bedroom's
+        nightstand, first seen after the shelf's was last seen and never watched before (probe
+        scenario, network, seed 0, 5 December 2026; score 0.535).
+        """
+        if self.arrival_frames <= 0 or self._arrived(merge.merged):
+            return merge
+        lost, found = merge.kept, merge.merged
+        twins = [other.symbol for other in index.of_class(lost.class_name)
+                 if other is not lost and other is not found
+                 and other.state in (AnchorState.CONFIRMED, AnchorState.MISSING)
+                 and colours_agree(other.colour, lost.colour, self.colour)
+                 and self._anywhere(other, lost) >= self.match_threshold]
+        if not twins:
+            return merge
+        return Undecided((lost,), (found,), (merge.score,),
+                         f"{found.symbol} looks like {lost.symbol} but so does {', '.join(sorted(twins))}, and the "
+                         "camera had not watched where it stands before it was seen: it may be another twin that "
+                         "stood there all along")
 
     # --- reappearances ----------------------------------------------------------------------
 

@@ -46,7 +46,7 @@ from typing import Protocol
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_scale
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_bearing, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs
@@ -303,7 +303,7 @@ class MatchingTableBuilder:
             percept, anchor = percepts[row], anchors[column]
             if whole[row, column] and percept.colour is not None and not anchor.colour_untellable(percept, self.colour):
                 if in_place[row, column] and anchor.colour_unchecked(percept.stamp, self.colour) and sized_view_differs(
-                        anchor.colour_by_size, percept.colour, view_scale(percept), self.colour):
+                        anchor.colour_by_size, percept.colour, view_scale(percept), self.colour, view_bearing(percept)):
                     confirmed = anchor.colour_disputed or self.colour.suspicion_confirmed(
                         anchor.colour_suspected, percept.stamp)
                     differing[row, column] = confirmed

@@ -407,6 +407,10 @@ SETTINGS: tuple[Setting, ...] = (
                 "One whole view is held only to the anchor's whole views at most this many times larger "
                 "or smaller (square root of the box's area): a view's colour changes with the size it is seen "
                 "at; with fewer than colour_minimum_views such views nothing is ruled out.", 1.0, 100.0),
+        Setting("colour_comparable_bearing", ("core", "colour", "comparable_bearing"),
+                "One whole view is held only to the anchor's whole views seen from at most this many degrees "
+                "around the object from it (object to camera, horizontally): an object's colour is not the same "
+                "from every side; 180: every side.", 1.0, 180.0),
         Setting("colour_place_radius", ("core", "colour", "place_radius"),
                 "How near (m, horizontally) to an anchor one whole view must stand for its colour to count "
                 "against it, nearer to no other anchor of its class (a view elsewhere is another object, or "

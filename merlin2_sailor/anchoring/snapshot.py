@@ -15,7 +15,13 @@ from typing import Any
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourModel
+from merlin2_sailor.anchoring.colour_evidence import (
+    ColourBySize,
+    ColourModel,
+    view_key_from_text,
+    view_key_order,
+    view_key_text,
+)
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.gallery import GALLERY_DTYPE
 from merlin2_sailor.errors import InvalidInputError
@@ -57,7 +63,8 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "gallery": gallery,
         "colour": None if anchor.colour is None else _colour_data(anchor.colour),
         "colour_by_size": None if anchor.colour_by_size is None else {
-            str(band): _colour_data(model) for band, model in sorted(anchor.colour_by_size.bands.items())},
+            view_key_text(key): _colour_data(model)
+            for key, model in sorted(anchor.colour_by_size.bands.items(), key=lambda item: view_key_order(item[0]))},
         "colour_seen": anchor.colour_seen,
         "colour_disputed": bool(anchor.colour_disputed),
         "missed_frames": int(anchor.missed_frames),
@@ -132,11 +139,12 @@ def _colour_data(model: ColourModel) -> dict[str, Any]:
 
 
 def _colour_by_size(data: Mapping[str, Any] | None) -> ColourBySize | None:
-    """A snapshot's colours by view size (None in snapshots written before they were kept, or
-    when the anchor had no colour)."""
+    """A snapshot's colours by view size and side (None in snapshots written before they were
+    kept, or when the anchor had no colour; sizes only, bearing not known, in those written
+    before sides)."""
     if data is None:
         return None
-    bands = {int(band): _colour(model) for band, model in data.items()}
+    bands = {view_key_from_text(key): _colour(model) for key, model in data.items()}
     if any(model is None for model in bands.values()):
         raise ValueError("colour_by_size must map size bands to colour models")
     return ColourBySize(bands)  # type: ignore[arg-type]

@@ -56,6 +56,9 @@ class Percept:
     on, not the background its 2D box also covers; see
     :func:`~merlin2_sailor.perception.colour_histogram.object_colour`), or None when unknown:
     the appearance evidence every matcher can afford, since it needs no network.
+    ``viewpoint`` is where the camera was (world frame) when it saw the object, or None when not
+    known: the anchoring layer sets it from the frame's camera pose, since an object's colour
+    depends on the side it is seen from (:mod:`~merlin2_sailor.anchoring.colour_evidence`).
     """
 
     class_name: str
@@ -70,3 +73,4 @@ class Percept:
     frame_id: str = "map"
     embedding: np.ndarray | None = None
     colour: np.ndarray | None = None
+    viewpoint: np.ndarray | None = None

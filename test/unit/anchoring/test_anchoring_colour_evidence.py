@@ -18,6 +18,7 @@ import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
 from merlin2_sailor.anchoring.colour_evidence import (
+    ColourBySize,
     ColourEvidenceConfig,
     ColourModel,
     colour_difference,
@@ -26,6 +27,9 @@ from merlin2_sailor.anchoring.colour_evidence import (
     combined,
     combined_by_size,
     view_differs,
+    view_key_from_text,
+    view_key_order,
+    view_key_text,
     with_sized_view,
 )
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
@@ -518,3 +522,77 @@ def test_colours_by_size_survive_a_snapshot_and_older_snapshots_learn_colour_afr
     older.restore(snapshot)
     # Its colour is learnt afresh: one no view could be held to would never be checked again.
     assert older.get("cup_1").colour_by_size is None and older.get("cup_1").colour is None
+
+
+# --- the side a view was seen from ------------------------------------------------------------
+
+#: A large object seen from its two ends: from the camera at the origin (looking along +x) and
+#: from a camera beyond it looking back (along -x).
+DOG_PLACE = (2.5, 0.0, 0.3)
+FRONT, BACK = camera_view(), camera_view(position=(5.0, 0.0, 1.0), yaw=math.pi)
+
+
+def see_from(anchoring, maker, items, start, view, frames):
+    result = None
+    for frame in range(frames):
+        stamp = start + frame * FRAME
+        result = anchoring.process([maker.percept(item, stamp) for item in items], view, stamp)
+    return result
+
+
+@pytest.mark.parametrize(("front_hue", "back_hue"), [(RED, GREEN), (3, 9), (BLUE, 16)])
+def test_a_view_from_a_side_the_anchor_never_saw_is_no_colour_evidence_against_it(front_hue, back_hue) -> None:
+    """A many-coloured object (a dog's face and its flank) seen again after a while from its other
+    side: its colour there is not the colour of the side its anchor knows, and it is still the
+    same object (probes of the scenario suite, 5 December 2026: second anchors of the dog and the
+    bird 0.03-0.05 m from their own)."""
+    front = SceneObject("dog", "dog", DOG_PLACE, (0.55, 0.3, 0.5), colour=mug_colour(front_hue))
+    back = SceneObject("dog", "dog", DOG_PLACE, (0.55, 0.3, 0.5), colour=mug_colour(back_hue))
+    anchoring, maker = rules(), PerceptMaker(seed=front_hue)
+    see_from(anchoring, maker, [front], 0.0, FRONT, 4)
+    result = see_from(anchoring, maker, [back], 60.0, BACK, SUSPICION_FRAMES + 3)
+    assert result.percept_symbols == ("dog_1",) and [a.symbol for a in anchoring.anchors] == ["dog_1"]
+    # Held to every side (the old rule), the same views make a second anchor.
+    every_side = rules(ColourEvidenceConfig(comparable_bearing=180.0))
+    see_from(every_side, maker, [front], 0.0, FRONT, 4)
+    assert see_from(every_side, maker, [back], 60.0, BACK, SUSPICION_FRAMES + 3).percept_symbols == ("dog_2",)
+
+
+@pytest.mark.parametrize(("own", "other"), [(RED, GREEN), (GREEN, BLUE)])
+def test_a_look_alike_put_in_an_objects_place_is_still_ruled_out_from_the_side_it_was_seen(own, other) -> None:
+    """The swap seen from the side the camera knew the mug from, once more from the other end."""
+    for view in (FRONT, BACK):
+        mug = SceneObject("red", "cup", KITCHEN, colour=mug_colour(own))
+        swapped_in = SceneObject("green", "cup", KITCHEN, colour=mug_colour(other))
+        anchoring, maker = rules(), PerceptMaker(seed=own)
+        see_from(anchoring, maker, [mug], 0.0, view, 4)
+        assert see_from(anchoring, maker, [swapped_in], 60.0, view, SUSPICION_FRAMES + 3).percept_symbols == ("cup_2",)
+
+
+def test_once_a_side_is_known_its_views_are_held_to_it() -> None:
+    """Both sides seen while the colour was fresh: each later view is held to its own side's views."""
+    front = SceneObject("dog", "dog", DOG_PLACE, (0.55, 0.3, 0.5), colour=mug_colour(RED))
+    back = SceneObject("dog", "dog", DOG_PLACE, (0.55, 0.3, 0.5), colour=mug_colour(GREEN))
+    other_back = SceneObject("other", "dog", DOG_PLACE, (0.55, 0.3, 0.5), colour=mug_colour(BLUE))
+    anchoring, maker = rules(), PerceptMaker(seed=2)
+    see_from(anchoring, maker, [front], 0.0, FRONT, 4)
+    see_from(anchoring, maker, [back], 1.0, BACK, 4)
+    assert [a.symbol for a in anchoring.anchors] == ["dog_1"]
+    assert see_from(anchoring, maker, [back], 60.0, BACK, SUSPICION_FRAMES + 3).percept_symbols == ("dog_1",)
+    assert see_from(anchoring, maker, [other_back], 120.0, BACK, SUSPICION_FRAMES + 3).percept_symbols == ("dog_2",)
+
+
+def test_bearings_are_kept_in_sectors_and_survive_a_snapshot() -> None:
+    model = ColourBySize()
+    colour = mug_colour(RED)
+    model.add(colour, 40.0, 0.1)
+    model.add(colour, 40.0, math.pi)
+    model.add(colour, 40.0, None)
+    assert sorted(model.bands, key=view_key_order) == [(10, None), (10, 0), (10, 4)]
+    assert model.comparable(40.0, 2.0, 0.2, 60.0).views == 2  # its own sector and the view of unknown bearing
+    assert model.comparable(40.0, 2.0, None, 60.0).views == 3  # a view of unknown bearing is held to all
+    assert model.comparable(40.0, 2.0, math.pi / 2, 30.0).views == 1
+    for key in model.bands:
+        assert view_key_from_text(view_key_text(key)) == key
+    with pytest.raises(ConfigurationError, match="colour_comparable_bearing"):
+        ColourEvidenceConfig(comparable_bearing=0.0)
