@@ -99,9 +99,18 @@ def before_sighting(anchor: Anchor, stamp: float, config: LifecycleConfig) -> No
     apart, or a few seconds when the camera sweeps past and back; 10 s keeps every confirmation
     of the held-out house replays (`sailor evaluate`: 170 anchors and 21 switches for the network,
     167 and 20 for the rules, as without it), where 5 s lost some (171 and 25; 167 and 22).
+
+    Its birth starts again too (``first_seen``): what the anchor stands for is decided by the
+    sightings that confirm it, and identity repair reads the birth as when its object was first
+    there ("two anchors seen side by side at one time are two objects"). A far view of the
+    living room's green mug left a tentative anchor that a look-alike of the hall's blue mug,
+    moved beside the green one a minute later, confirmed; born before the blue mug was last seen
+    in the hall, that anchor could never be the blue mug, and the search for it gave up
+    (scenario suite, `moved_while_its_twin_is_watched`, network, seed 2, 5 December 2026).
     """
     if anchor.state is AnchorState.TENTATIVE and stamp - anchor.last_seen > config.confirm_within:
         anchor.times_seen = 0
+        anchor.first_seen = stamp
 
 
 def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleConfig) -> bool:

@@ -34,6 +34,12 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    that first view is only held apart from the anchor (``held``). A view is whole *for an anchor*
    as appearance takes it (:func:`.partial_view.comparable_views`): a view showing clearly less of
    a large object than the anchor's whole views did has a part's colour, not the object's.
+   A view anywhere in the disc of a search for an anchor (which the table counts as in place)
+   is gated from it when its colour differs from the anchor's mean over all its views, as a
+   search's merge of two anchors asks (:func:`~.colour_evidence.view_differs`): a white mug 2 m
+   from the middle of the searched bedroom, never anchored, had taken the lost blue mug's symbol
+   on its first view (scenario suite, `moved_while_its_twin_is_watched`, network, seed 0,
+   5 December 2026).
 """
 
 from __future__ import annotations
@@ -49,7 +55,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_bearing, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs, view_differs
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.partial_view import comparable_views
@@ -254,6 +260,13 @@ class MatchingTableBuilder:
             continuations &= ~apart
             disputed = tuple(anchors[column] for column in np.flatnonzero(differing.any(axis=0)))
             suspected = tuple(anchors[column] for column in np.flatnonzero(held.any(axis=0)))
+            if anchor_columns.search_radii is not None:
+                searched_apart = self._searched_another_colour(
+                    percepts, anchors, whole_for, ~gated & (anchor_columns.search_radii > 0.0)[np.newaxis, :])
+                scores[searched_apart] = self.config.gated_score
+                gated |= searched_apart
+                continuations &= ~searched_apart
+                ruled_out |= searched_apart
         return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded, disputed, ruled_out,
                              suspected, held)
 
@@ -314,6 +327,18 @@ class MatchingTableBuilder:
                 # one that cannot be held to the anchor's, is no way back.
                 ruled_out[row, column] = anchor.colour_disputed and anchor.state is AnchorState.MISSING
         return ruled_out, differing, held
+
+    def _searched_another_colour(
+        self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: np.ndarray, open_pairs: np.ndarray,
+    ) -> np.ndarray:
+        """(P, A) bool: the pairs (among ``open_pairs``, those with a searched anchor) of a whole
+        view whose colour differs from the anchor's over all its views (see the module docstring)."""
+        apart = np.zeros(open_pairs.shape, dtype=bool)
+        if self.colour.minimum_views == 0:
+            return apart
+        for row, column in zip(*np.nonzero(open_pairs & whole), strict=True):
+            apart[row, column] = view_differs(anchors[column].colour, percepts[row].colour, self.colour)
+        return apart
 
     def _in_place(self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...]) -> np.ndarray:
         """(P, A) bool: the percept stands in the anchor's place: within ``place_radius``

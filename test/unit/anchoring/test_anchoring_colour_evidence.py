@@ -596,3 +596,26 @@ def test_bearings_are_kept_in_sectors_and_survive_a_snapshot() -> None:
         assert view_key_from_text(view_key_text(key)) == key
     with pytest.raises(ConfigurationError, match="colour_comparable_bearing"):
         ColourEvidenceConfig(comparable_bearing=0.0)
+
+
+#: The camera in the living room's doorway, looking into it (along +y), 3 m from the searched spot.
+INTO_THE_LIVING_ROOM = camera_view(position=(1.5, 3.0, 1.0), yaw=math.pi / 2)
+
+
+@pytest.mark.parametrize(("sought_hue", "seen_hue", "taken"), [
+    (BLUE, 0, False), (BLUE, GREEN, False), (RED, GREEN, False), (BLUE, BLUE, True), (GREEN, GREEN, True)])
+def test_a_view_of_another_colour_anywhere_in_a_searched_disc_is_not_the_sought_object(
+        sought_hue, seen_hue, taken) -> None:
+    """The search is under way before anything is seen there: the first view of a mug in the disc
+    meets the sought anchor in the matching table itself, not in a merge of two anchors; its colour
+    is held to the anchor's all the same (`moved_while_its_twin_is_watched`, network, seed 0: a
+    white mug 2 m from the middle of the searched bedroom took the lost blue mug's symbol)."""
+    sought = SceneObject("sought", "cup", KITCHEN, colour=mug_colour(sought_hue))
+    seen = SceneObject("seen", "cup", tuple(LIVING_ROOM + np.array((0.6, 0.9, 0.0))), colour=mug_colour(seen_hue))
+    anchoring, maker = rules(), PerceptMaker(seed=sought_hue + seen_hue)
+    see(anchoring, maker, [sought], 0.0)
+    see(anchoring, maker, [], 1.0, frames=1)
+    search(anchoring, "cup_1", WALKED_THERE - 1.0)
+    result = see_from(anchoring, maker, [seen], WALKED_THERE, INTO_THE_LIVING_ROOM, 4)
+    assert result.percept_symbols == (("cup_1",) if taken else ("cup_2",))
+    assert anchoring.get("cup_1").state is (AnchorState.CONFIRMED if taken else AnchorState.MISSING)

@@ -383,3 +383,21 @@ def test_a_newcomer_first_seen_from_afar_is_judged_by_its_views_comparable_to_th
     index.remove("cup_2")
     index.add(only_far)
     assert decide(0.5) is None
+
+
+def test_a_tentative_anchor_confirmed_long_after_its_first_sighting_may_be_the_lost_object(anchoring, maker):
+    """A glimpse of a mug in the living room leaves a tentative anchor while the blue mug is still in
+    the kitchen; a minute later the blue mug, moved there, confirms that anchor. Born again with its
+    count, it may be the blue mug (`moved_while_its_twin_is_watched`, network, seed 2, 5 December
+    2026: it could not, and the search gave up)."""
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    glimpse = SceneObject("glimpse", "cup", tuple(LIVING_ROOM), looks_like="blue_mug")
+    see(anchoring, maker, [KITCHEN_MUG, glimpse], 2 * FRAME, camera=False)
+    see(anchoring, maker, [KITCHEN_MUG], 3 * FRAME, camera=False)
+    assert anchoring.get("cup_2").state is AnchorState.TENTATIVE
+    see(anchoring, maker, [], 1.0)  # the kitchen seen empty
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 60.0, camera=False, positions={"blue_mug": LIVING_ROOM})
+    assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and anchoring.get("cup_2").first_seen == 60.0
+    result = search_living_room(anchoring, "cup_1", 61.0)
+    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]

@@ -125,9 +125,12 @@ def test_sightings_of_a_tentative_anchor_far_apart_do_not_confirm_it(make_anchor
         assert AnchorEventKind.CONFIRMED not in kinds(result)
         anchoring.process([], turned_away, stamp + 0.5)
     assert anchoring.get("cup_1").state is AnchorState.TENTATIVE
+    # Its birth starts again with its count: what it stands for is what confirms it.
+    assert anchoring.get("cup_1").first_seen == 24.0
     # Two sightings a frame apart confirm it, under the symbol it had.
     result = anchoring.process([maker.percept(cup, 24.0 + FRAME)], camera_view(), 24.0 + FRAME)
     assert AnchorEventKind.CONFIRMED in kinds(result) and anchoring.get("cup_1").state is AnchorState.CONFIRMED
+    assert anchoring.get("cup_1").first_seen == 24.0
 
 
 def test_occluded_object_is_not_marked_missing(make_anchoring, maker, kitchen):
