@@ -401,3 +401,15 @@ def test_a_tentative_anchor_confirmed_long_after_its_first_sighting_may_be_the_l
     assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and anchoring.get("cup_2").first_seen == 60.0
     result = search_living_room(anchoring, "cup_1", 61.0)
     assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
+
+
+def test_a_search_for_an_anchor_perception_has_confirmed_leaves_it_where_it_was_seen(anchoring, maker):
+    """A find visits the stop nearest where the sought object was just seen and announces a search
+    there; the anchor must stay where perception put it, not move to the stop's disc."""
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    before = anchoring.get("cup_1").position.copy()
+    result = search_living_room(anchoring, "cup_1", 1.0)
+    assert result.events == ()
+    anchor = anchoring.get("cup_1")
+    assert anchor.state is AnchorState.CONFIRMED and anchor.expectation is None
+    np.testing.assert_allclose(anchor.position, before)
