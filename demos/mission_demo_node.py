@@ -410,7 +410,7 @@ class MissionDemoNode(Node):
     def _on_anchors(self, message: AnchorArray) -> None:
         records = [
             AnchorRecord(a.symbol, a.class_name, (a.position.x, a.position.y, a.position.z),
-                         _STATE_NAMES.get(a.state, "?"))
+                         _STATE_NAMES.get(a.state, "?"), tuple(a.indistinguishable_from))
             for a in message.anchors
         ]
         views = [(record, a.last_seen.sec + a.last_seen.nanosec * 1e-9, (a.size.x, a.size.y, a.size.z))

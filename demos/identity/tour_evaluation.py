@@ -110,7 +110,8 @@ class _Contender:
         return result
 
     def records(self, claiming_only: bool = False) -> list[AnchorRecord]:
-        return [AnchorRecord(a.symbol, a.class_name, tuple(float(v) for v in a.position), a.state.value)
+        return [AnchorRecord(a.symbol, a.class_name, tuple(float(v) for v in a.position), a.state.value,
+                             tuple(a.indistinguishable_from))
                 for a in self.anchoring.anchors if not claiming_only or a.state.value in _CLAIMING]
 
     def score(self, world: World) -> TourScore:

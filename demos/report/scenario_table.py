@@ -56,14 +56,14 @@ class ScenarioRun:
                 + (f" [duplicate {'; '.join(duplicates)}]" if duplicates else ""))
 
 
-COLUMNS = ("scenario", "seed", "matcher", "outcome", "right/wrong", "duplicates", "identity switches", "time (s)",
-           "why wrong")
+COLUMNS = ("scenario", "seed", "matcher", "outcome", "right/wrong", "duplicates", "undecided", "identity switches",
+           "time (s)", "why wrong")
 
 
 def _cells(run: ScenarioRun) -> tuple[str, ...]:
     verdict = run.verdict
-    figures = ("-", "-", f"{run.wall_seconds:.0f}") if verdict is None else (
-        str(verdict.duplicates), str(verdict.identity_switches), f"{verdict.seconds:.0f}")
+    figures = ("-", "-", "-", f"{run.wall_seconds:.0f}") if verdict is None else (
+        str(verdict.duplicates), str(verdict.undecided), str(verdict.identity_switches), f"{verdict.seconds:.0f}")
     why = run.note if verdict is None else "; ".join(verdict.problems)
     return (run.scenario, str(run.seed), run.matcher, run.outcome, "right" if run.right else "WRONG", *figures,
             why.replace("|", "/"))
@@ -76,6 +76,7 @@ def to_markdown(runs: Sequence[ScenarioRun]) -> str:
     right = sum(run.right for run in runs)
     lines += ["", f"{right} of {len(runs)} runs right; "
               f"{sum(run.verdict.duplicates for run in runs if run.verdict)} duplicate anchor(s), "
+              f"{sum(run.verdict.undecided for run in runs if run.verdict)} left undecided, "
               f"{sum(run.verdict.identity_switches for run in runs if run.verdict)} identity switch(es) in all."]
     origins = [(run, origin) for run in runs if run.verdict for origin in run.verdict.duplicate_origins]
     if origins:

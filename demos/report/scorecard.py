@@ -37,6 +37,8 @@ class AnchorRecord:
     class_name: str
     position: tuple[float, float, float]
     state: str = "confirmed"
+    indistinguishable_from: tuple[str, ...] = ()
+    """The anchors the anchoring layer said this one cannot be told from (a search left undecided)."""
 
 
 def associate(
@@ -93,6 +95,10 @@ class Scorecard:
     facts_right: int
     facts_wrong: tuple[str, ...]
     position_tolerance: float
+    undecided: tuple[str, ...] = ()
+    """Missing anchors the anchoring layer said it cannot tell from an anchor of an object in the
+    world: a second symbol it knows of and names (the truth it can justify: "one of these two"),
+    counted apart from the duplicates it does not know of."""
 
     @property
     def mean_position_error(self) -> float:
@@ -112,6 +118,7 @@ class Scorecard:
             "anchored": self.anchored,
             "not_anchored": list(self.not_anchored),
             "duplicates": list(self.duplicates),
+            "undecided": list(self.undecided),
             "spurious": list(self.spurious),
             "mean_position_error_m": self.mean_position_error,
             "max_position_error_m": self.max_position_error,
@@ -133,6 +140,7 @@ class Scorecard:
             ("anchored (exactly one anchor each)", f"{self.anchored} / {self.objects}"),
             ("not anchored", listed(self.not_anchored)),
             ("duplicate anchors", listed(self.duplicates)),
+            ("missing, said to be indistinguishable from another", listed(self.undecided)),
             ("anchors of nothing", listed(self.spurious)),
             ("position error, mean / max", f"{self.mean_position_error:.3f} m / {self.max_position_error:.3f} m"),
             (f"positions off by more than {self.position_tolerance} m", listed(self.wrong_positions)),
@@ -180,9 +188,12 @@ def score(
     # The last anchor of an object taken out of the world, MISSING, is the truth ("it is gone"):
     # neither a duplicate nor a spurious anchor. Confirmed, it would still claim the object is there.
     gone = {symbol for object_id, symbol in history.last_symbol.items() if object_id not in by_id}
-    duplicates, spurious = [], []
+    duplicates, spurious, undecided = [], [], []
     for anchor in unmatched:
         if anchor.state == "missing" and anchor.symbol in gone:
+            continue
+        if anchor.state == "missing" and _said_indistinguishable(anchor, by_symbol, matched_symbols):
+            undecided.append(anchor.symbol)
             continue
         near_same_class = any(
             obj.class_name == anchor.class_name
@@ -205,6 +216,7 @@ def score(
         not_anchored=tuple(sorted(obj.id for obj in truth if obj.id not in association)),
         duplicates=tuple(sorted(duplicates)),
         spurious=tuple(sorted(spurious)),
+        undecided=tuple(sorted(undecided)),
         position_errors=errors,
         wrong_positions=tuple(sorted(i for i, e in errors.items() if e > position_tolerance)),
         identity_switches={i: n for i, n in history.switches.items() if n},
@@ -212,3 +224,16 @@ def score(
         facts_wrong=tuple(facts_wrong),
         position_tolerance=position_tolerance,
     )
+
+
+def _said_indistinguishable(anchor: AnchorRecord, by_symbol: Mapping[str, AnchorRecord], matched: set[str]) -> bool:
+    """Whether ``anchor`` is one the anchoring layer left undecided: missing and named as not to be
+    told from an anchor of its class that stands for an object of the world.
+
+    Twins found where the camera never looked cannot be told apart by any evidence (the issue asks
+    the robot to say so, not guess), so the sought anchor stays missing beside its candidate's; it
+    is a doubt stated, not an object silently anchored twice. A named partner that anchors nothing,
+    or of another class, does not excuse it.
+    """
+    return any(symbol in matched and by_symbol[symbol].class_name == anchor.class_name
+               for symbol in anchor.indistinguishable_from)

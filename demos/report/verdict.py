@@ -54,10 +54,12 @@ class Verdict:
     duplicate_origins: tuple[str, ...] = ()
     """Each duplicate anchor and where it came from: why it, and the anchor of the object it stands
     beside, were anchored anew (the anchoring node's acquired events), a duplicate's first question."""
+    undecided: int = 0
+    """Missing anchors left beside the anchor they were said not to be told from (not duplicates)."""
 
     def as_dict(self) -> dict[str, Any]:
         return {"outcome": self.outcome, "right": self.right, "problems": list(self.problems),
-                "duplicates": self.duplicates, "identity_switches": self.identity_switches,
+                "duplicates": self.duplicates, "undecided": self.undecided, "identity_switches": self.identity_switches,
                 "seconds": round(self.seconds, 1), "claimed": self.claimed,
                 "duplicate_origins": list(self.duplicate_origins)}
 
@@ -136,6 +138,7 @@ def judge(card: Mapping[str, Any], expect: Expectation | None = None) -> Verdict
         right=not problems,
         problems=tuple(problems),
         duplicates=len(card.get("duplicates") or ()),
+        undecided=len(card.get("undecided") or ()),
         identity_switches=sum(int(n) for n in scorecard_switches.values()),
         seconds=float((card.get("outcome") or {}).get("seconds", 0.0)),
         claimed=claimed,

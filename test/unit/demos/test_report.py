@@ -75,6 +75,30 @@ def test_the_missing_anchor_of_a_removed_object_is_no_duplicate():
     assert never_an_object.duplicates == ("cup_9",)
 
 
+def test_a_missing_anchor_said_indistinguishable_from_an_anchored_object_is_undecided_not_a_duplicate():
+    """A twin found where the camera never looked: the sought anchor stays missing beside its
+    candidate's, the anchoring layer naming the candidate. A doubt it states is not a duplicate it
+    does not know of; a named partner that anchors nothing, or of another class, excuses nothing."""
+    mug_a_moved = (1.4, 0.0, 0.8)
+    twin_left = AnchorRecord("cup_1", "cup", (1.0, 0.0, 0.8), "missing", ("cup_7",))
+    found = AnchorRecord("cup_7", "cup", mug_a_moved)
+    card = score([TrueObject("mug_a", "cup", mug_a_moved), *TRUTH[1:]],
+                 [twin_left, found, AnchorRecord("cup_2", "cup", (4.0, 0.0, 0.8))])
+    assert card.undecided == ("cup_1",) and card.duplicates == ()
+    assert card.to_dict()["undecided"] == ["cup_1"]
+    assert "| missing, said to be indistinguishable from another | cup_1 |" in card.to_markdown()
+    beside_mug_a, on_mug_a = (1.3, 0.0, 0.8), (1.0, 0.0, 0.8)
+    named_nothing = AnchorRecord("cup_1", "cup", beside_mug_a, "missing", ("cup_99",))
+    assert score(TRUTH, [named_nothing, AnchorRecord("cup_7", "cup", on_mug_a)]).duplicates == ("cup_1",)
+    confirmed = AnchorRecord("cup_1", "cup", beside_mug_a, "confirmed", ("cup_7",))
+    card = score(TRUTH, [confirmed, AnchorRecord("cup_7", "cup", on_mug_a)])
+    assert card.duplicates == ("cup_1",) and card.undecided == ()
+    other_class = AnchorRecord("cup_1", "cup", beside_mug_a, "missing", ("book_1",))
+    card = score(TRUTH, [other_class, AnchorRecord("cup_7", "cup", on_mug_a),
+                         AnchorRecord("book_1", "book", (0.0, 3.0, 0.5))])
+    assert card.duplicates == ("cup_1",)
+
+
 def test_identity_switches_are_symbol_changes_of_one_object():
     history = IdentityHistory()
     history.record({"mug_a": "cup_1", "mug_b": "cup_2"})

@@ -27,13 +27,13 @@ RUNS = [
 
 def test_each_run_is_one_row_with_its_outcome_verdict_and_figures() -> None:
     lines = to_markdown(RUNS).splitlines()
-    assert lines[0] == ("| scenario | seed | matcher | outcome | right/wrong | duplicates | identity switches "
-                        "| time (s) | why wrong |")
-    assert lines[2] == "| default | 0 | rules | found as cup_1 | right | 0 | 2 | 88 |  |"
-    assert lines[3].startswith("| removed | 0 | rules | found as cup_1 | WRONG | 1 | 3 | 91 | claimed cup_1")
-    assert lines[4] == "| swapped | 1 | network | hang | WRONG | - | - | 420 | not done after 420 s |"
+    assert lines[0] == ("| scenario | seed | matcher | outcome | right/wrong | duplicates | undecided "
+                        "| identity switches | time (s) | why wrong |")
+    assert lines[2] == "| default | 0 | rules | found as cup_1 | right | 0 | 0 | 2 | 88 |  |"
+    assert lines[3].startswith("| removed | 0 | rules | found as cup_1 | WRONG | 1 | 0 | 3 | 91 | claimed cup_1")
+    assert lines[4] == "| swapped | 1 | network | hang | WRONG | - | - | - | 420 | not done after 420 s |"
     assert lines[5].startswith("| twin_moved | 2 | network | crash | WRONG |")
-    assert lines[7] == "1 of 4 runs right; 1 duplicate anchor(s), 5 identity switch(es) in all."
+    assert lines[7] == "1 of 4 runs right; 1 duplicate anchor(s), 0 left undecided, 5 identity switch(es) in all."
     # Where each duplicate came from, under the table.
     assert lines[-1] == "- removed seed 0 rules: cup_2 (confirmed), anchored anew: cup_1 ruled out by colour"
 

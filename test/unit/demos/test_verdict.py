@@ -159,3 +159,12 @@ def test_each_duplicate_comes_with_where_it_came_from_and_an_old_scorecard_says_
     assert verdict.duplicate_origins == ("tv_2 (confirmed), anchored anew: tv_1 ruled out by colour",
                                          "dog_3: origin unknown")
     assert verdict.as_dict()["duplicate_origins"] == list(verdict.duplicate_origins)
+
+
+def test_anchors_left_undecided_are_counted_apart_from_duplicates_and_old_scorecards_have_none() -> None:
+    card = scorecard()
+    card["undecided"] = ["cup_1"]
+    verdict = judge(card)
+    assert (verdict.duplicates, verdict.undecided) == (0, 1)
+    assert verdict.as_dict()["undecided"] == 1
+    assert judge(scorecard()).undecided == 0
