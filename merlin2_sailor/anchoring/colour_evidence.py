@@ -354,8 +354,7 @@ class ColourBySize:
             return None
         window = math.radians(bearing_window)
         known = bearing is not None and math.isfinite(bearing)
-        ordered = sorted(self.bands.items(), key=lambda item: view_key_order(item[0]))
-        chosen = [model for (band, sector), model in ordered
+        chosen = [model for (band, sector), model in self.ordered()
                   if size / ratio <= band_centre(band) <= size * ratio
                   and (not known or sector is None or bearing_gap(sector_centre(sector), bearing) <= window)]
         if not chosen:
@@ -364,6 +363,10 @@ class ColourBySize:
         for model in chosen[1:]:
             result = result.merged(model)
         return result
+
+    def ordered(self) -> list[tuple[ViewKey, ColourModel]]:
+        """The bands in a fixed order (sums and snapshots the same on every run)."""
+        return sorted(self.bands.items(), key=lambda item: view_key_order(item[0]))
 
     def merged(self, other: ColourBySize) -> ColourBySize:
         """Both anchors' views, band by band (an anchor merged into another)."""

@@ -19,7 +19,6 @@ from merlin2_sailor.anchoring.colour_evidence import (
     ColourBySize,
     ColourModel,
     view_key_from_text,
-    view_key_order,
     view_key_text,
 )
 from merlin2_sailor.anchoring.expectation import Expectation
@@ -64,7 +63,7 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "colour": None if anchor.colour is None else _colour_data(anchor.colour),
         "colour_by_size": None if anchor.colour_by_size is None else {
             view_key_text(key): _colour_data(model)
-            for key, model in sorted(anchor.colour_by_size.bands.items(), key=lambda item: view_key_order(item[0]))},
+            for key, model in anchor.colour_by_size.ordered()},
         "colour_seen": anchor.colour_seen,
         "colour_disputed": bool(anchor.colour_disputed),
         "missed_frames": int(anchor.missed_frames),
