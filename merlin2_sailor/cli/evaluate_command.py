@@ -5,9 +5,11 @@ used in training or model selection), the matching network and the hand-tuned ru
 scored side by side: the confusion matrix and accuracy / precision / recall / F1 over every pair
 and over the look-alike pairs (same class, near). Then each scene is replayed through the whole
 anchoring layer with each matcher and the symbols are scored against the ground truth (ID
-switches, IDF1, via motmetrics). Text on stdout; with ``--output``, a confusion-matrix PNG and
-a JSON of every number. ``--source`` evaluates on a public data set's split instead (see
-``sailor train``). ``--world FILE`` tours a simulated house with each matcher instead
+switches, IDF1, via motmetrics). Every pair is also scored at every threshold (the F1 at the
+anchoring layer's threshold beside the best one: how much of a shortfall is where the cut is,
+not what the scores tell apart). Text on stdout; with ``--output``, a confusion-matrix PNG, pair
+F1 against the threshold (PNG) and a JSON of every number. ``--source`` evaluates on a public
+data set's split instead (see ``sailor train``). ``--world FILE`` tours a simulated house with each matcher instead
 (:mod:`.world_evaluation`): duplicate anchors and identity switches against the world's truth.
 Both matchers and the anchoring layer are built from the anchoring node's settings
 (config/anchoring.yaml; ``--launch``, ``--params``, ``--set`` as for ``sailor replay``), by name
@@ -21,10 +23,14 @@ import json
 import time
 from dataclasses import asdict, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from merlin2_sailor.cli.anchoring_settings import add_settings_arguments, settings_from_arguments
 from merlin2_sailor.cli.train_command import DEFAULT_SCENES, DEFAULT_SOURCE, SOURCE_HELP, embedding_cache, pair_source
 from merlin2_sailor.cli.world_evaluation import add_world_arguments, run_world
+
+if TYPE_CHECKING:
+    from merlin2_sailor.training.metrics import ThresholdSweep
 
 #: The matchers compared, each built from the same settings, by name.
 COMPARED_MATCHERS = ("network", "rules")
@@ -68,10 +74,10 @@ def run(arguments: argparse.Namespace) -> int:
     from merlin2_sailor.models import default_weights_path
     from merlin2_sailor.training.generated_dataset import GeneratedPairSet
     from merlin2_sailor.training.identity_evaluation import evaluate_identities, format_identity_table
-    from merlin2_sailor.training.metrics import format_confusion, format_table
+    from merlin2_sailor.training.metrics import format_confusion, format_sweeps, format_table
     from merlin2_sailor.training.pair_dataset import PairDatasetConfig
     from merlin2_sailor.training.pair_scoring import evaluate_pairs
-    from merlin2_sailor.training.plots import plot_confusions
+    from merlin2_sailor.training.plots import plot_confusions, plot_threshold_sweeps
 
     started = time.perf_counter()
     # The anchoring node's settings (the same parameter files), offline; each matcher compared is
@@ -104,6 +110,12 @@ def run(arguments: argparse.Namespace) -> int:
           "so by the rules)")
     print(format_table(table))
     print()
+    sweeps = {name: result.all_pairs_sweep for name, result in pairs.items()}
+    sweeps.update({f"{name} as run": result.as_run_sweep for name, result in pairs.items()
+                   if built[name].uses_appearance})
+    print("every pair of Algorithm 3 again, at every threshold: how much of the F1 is where the cut is")
+    print(format_sweeps(sweeps, threshold))
+    print()
     for name, result in pairs.items():
         print(format_confusion(name, result.all_pairs))
         print()
@@ -123,16 +135,25 @@ def run(arguments: argparse.Namespace) -> int:
         folder = Path(arguments.output)
         folder.mkdir(parents=True, exist_ok=True)
         image = plot_confusions(folder / "confusion.png", table)
+        sweep_image = plot_threshold_sweeps(folder / "threshold_sweep.png", sweeps, threshold)
         report = {
             "weights": str(weights),
             "source": arguments.source,
             "split": arguments.split, "scenes": arguments.scenes, "first": arguments.first, "seed": arguments.seed,
             "pairs": {name: counts.as_dict() for name, counts in table.items()},
+            "threshold_sweep": {name: _sweep_summary(sweep, threshold) for name, sweep in sweeps.items()},
             "anchoring": {name: metrics.as_dict() for name, metrics in identities.items()},
             "source_config": asdict(source.config),
             "anchoring_settings": parameter_values(settings),
             "seconds": round(seconds, 1),
         }
         (folder / "metrics.json").write_text(json.dumps(report, indent=2, default=str) + "\n")
-        print(f"wrote {image} and {folder / 'metrics.json'}")
+        print(f"wrote {image}, {sweep_image} and {folder / 'metrics.json'}")
     return 0
+
+
+def _sweep_summary(sweep: ThresholdSweep, threshold: float) -> dict:
+    """A sweep in metrics.json: the counts at the anchoring threshold and at the best one."""
+    best_threshold, best = sweep.best()
+    return {"threshold": threshold, "at_threshold": sweep.at(threshold).as_dict(),
+            "best_threshold": best_threshold, "best": best.as_dict()}

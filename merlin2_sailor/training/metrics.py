@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -116,3 +116,83 @@ def format_confusion(name: str, counts: ConfusionCounts) -> str:
             f"{'different':<14}{counts.false_positives:>10d}{counts.true_negatives:>11d}",
         ]
     )
+
+
+@dataclass(slots=True)
+class ThresholdSweep:
+    """Pair scores binned by label, so the confusion counts at any threshold of a grid are read
+    after one streamed pass.
+
+    Why: one threshold's F1 mixes two questions, whether true and false pairs are scored apart at
+    all, and where the cut between them is put. The matching network is trained to favour recall
+    (``positive_weight``: a missed pair makes a duplicate anchor), so its cut is placed for the
+    anchoring layer, not for the pair table; the best F1 over thresholds says how much of the
+    table's shortfall is the cut's. Thresholds lie on a grid of ``1 / bins``; a score of exactly a
+    grid value counts as reaching it (the anchoring layer's ``>=``).
+    """
+
+    bins: int = 1000
+    positives: np.ndarray = field(default=None)  # type: ignore[assignment]
+    negatives: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.bins < 1:
+            raise InvalidInputError(f"a threshold sweep needs at least one bin, got {self.bins}.")
+        if self.positives is None:
+            self.positives = np.zeros(self.bins + 1, dtype=np.int64)
+        if self.negatives is None:
+            self.negatives = np.zeros(self.bins + 1, dtype=np.int64)
+
+    def add(self, labels: np.ndarray, scores: np.ndarray) -> None:
+        """Count more pairs (a score outside [0, 1] or NaN counts as the nearest end, NaN as 0)."""
+        labels = np.asarray(labels, dtype=bool)
+        scores = np.nan_to_num(np.asarray(scores, dtype=np.float64), nan=0.0)
+        if labels.shape != scores.shape:
+            raise InvalidInputError(f"{labels.shape[0]} labels but {scores.shape[0]} scores.")
+        index = np.clip(np.floor(scores * self.bins + 1e-9), 0, self.bins).astype(np.int64)
+        self.positives += np.bincount(index[labels], minlength=self.bins + 1)
+        self.negatives += np.bincount(index[~labels], minlength=self.bins + 1)
+
+    def __add__(self, other: ThresholdSweep) -> ThresholdSweep:
+        if other.bins != self.bins:
+            raise InvalidInputError(f"threshold sweeps of {self.bins} and {other.bins} bins cannot be added.")
+        return ThresholdSweep(self.bins, self.positives + other.positives, self.negatives + other.negatives)
+
+    def at(self, threshold: float) -> ConfusionCounts:
+        """The counts with pairs scored at or above ``threshold`` (rounded to the grid) taken as same."""
+        first = int(np.clip(round(threshold * self.bins), 0, self.bins))
+        true_positives, false_positives = int(self.positives[first:].sum()), int(self.negatives[first:].sum())
+        return ConfusionCounts(true_positives, false_positives, int(self.positives.sum()) - true_positives,
+                               int(self.negatives.sum()) - false_positives)
+
+    def thresholds(self) -> np.ndarray:
+        return np.arange(self.bins + 1, dtype=np.float64) / self.bins
+
+    def f1_curve(self) -> np.ndarray:
+        """F1 at every threshold of the grid (NaN where nothing is predicted or present)."""
+        true_positives = np.cumsum(self.positives[::-1])[::-1].astype(np.float64)
+        false_positives = np.cumsum(self.negatives[::-1])[::-1].astype(np.float64)
+        false_negatives = float(self.positives.sum()) - true_positives
+        denominator = 2 * true_positives + false_positives + false_negatives
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(denominator > 0, 2 * true_positives / denominator, np.nan)
+
+    def best(self) -> tuple[float, ConfusionCounts]:
+        """The threshold of the grid with the highest F1 (ties: the lowest), and its counts."""
+        curve = self.f1_curve()
+        if not np.isfinite(curve).any():
+            return math.nan, self.at(0.0)
+        threshold = float(self.thresholds()[int(np.nanargmax(curve))])
+        return threshold, self.at(threshold)
+
+
+def format_sweeps(rows: Mapping[str, ThresholdSweep], threshold: float) -> str:
+    """One line per named sweep: F1 at ``threshold`` (the anchoring layer's) and the best over the grid."""
+    width = max([len(name) for name in rows] + [8])
+    lines = []
+    for name, sweep in rows.items():
+        best_threshold, best = sweep.best()
+        lines.append(f"{name:<{width}}  F1 {sweep.at(threshold).f1:.4f} at {threshold:.3f}; best {best.f1:.4f} at "
+                     f"{best_threshold:.3f} (precision {best.precision:.4f}, recall {best.recall:.4f}, "
+                     f"{best.false_positives} false, {best.false_negatives} missed)")
+    return "\n".join(lines)

@@ -18,7 +18,7 @@ from merlin2_sailor.anchoring.features import PairFeatures
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.training.embedding_cache import EmbeddingCache
-from merlin2_sailor.training.metrics import ConfusionCounts
+from merlin2_sailor.training.metrics import ConfusionCounts, ThresholdSweep
 from merlin2_sailor.training.pair_dataset import PairChunk
 
 
@@ -46,7 +46,8 @@ class PairEvaluation:
     occluder; only a source that renders whole frames, such as the house source, knows); and,
     apart, over the searched pairs and the replaced pairs (:mod:`.pair_dataset`: appearance alone
     must tell). ``as_run``: every pair of Algorithm 3 again, scored as the anchoring layer scores
-    it (:func:`as_run`); it differs from ``all_pairs`` only for a matcher that reads the look."""
+    it (:func:`as_run`); it differs from ``all_pairs`` only for a matcher that reads the look.
+    ``all_pairs_sweep`` and ``as_run_sweep``: the same pairs' scores by label, for every threshold."""
 
     all_pairs: ConfusionCounts = field(default_factory=ConfusionCounts)
     look_alike: ConfusionCounts = field(default_factory=ConfusionCounts)
@@ -54,6 +55,8 @@ class PairEvaluation:
     searched: ConfusionCounts = field(default_factory=ConfusionCounts)
     replaced: ConfusionCounts = field(default_factory=ConfusionCounts)
     as_run: ConfusionCounts = field(default_factory=ConfusionCounts)
+    all_pairs_sweep: ThresholdSweep = field(default_factory=ThresholdSweep)
+    as_run_sweep: ThresholdSweep = field(default_factory=ThresholdSweep)
 
 
 def evaluate_pairs(
@@ -68,6 +71,8 @@ def evaluate_pairs(
         scores_as_run = matcher.score_pairs(as_run(features, chunk)) if matcher.uses_appearance else scores
         result.as_run = result.as_run + ConfusionCounts.from_scores(chunk.labels[paper], scores_as_run[paper],
                                                                     threshold)
+        result.all_pairs_sweep.add(chunk.labels[paper], scores[paper])
+        result.as_run_sweep.add(chunk.labels[paper], scores_as_run[paper])
         subsets = (("all_pairs", paper), ("look_alike", chunk.look_alike & paper), ("partial", chunk.partial & paper),
                    ("searched", chunk.searched), ("replaced", chunk.replaced))
         for subset, mask in subsets:

@@ -1,4 +1,4 @@
-"""PNG plots drawn with OpenCV: the loss curves and the confusion matrices.
+"""PNG plots drawn with OpenCV: the loss curves, the confusion matrices and pair F1 against the threshold.
 
 matplotlib is not a dependency of this package; OpenCV (already one, for crops) draws lines,
 rectangles and text well enough for two small figures.
@@ -6,13 +6,14 @@ rectangles and text well enough for two small figures.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from merlin2_sailor.training.metrics import ConfusionCounts
+from merlin2_sailor.training.metrics import ConfusionCounts, ThresholdSweep
 
 _WHITE = (255, 255, 255)
 _BLACK = (0, 0, 0)
@@ -102,3 +103,45 @@ def _write(path: str | Path, image: np.ndarray) -> Path:
     if not cv2.imwrite(str(path), image):
         raise OSError(f"could not write the plot {path}")
     return path
+
+
+def plot_threshold_sweeps(path: str | Path, sweeps: Mapping[str, ThresholdSweep], threshold: float) -> Path:
+    """F1 of each named sweep against the threshold, the anchoring layer's ``threshold`` marked and
+    each curve's best point labelled: where the cut is, and where it would score the pairs best."""
+    width, height, left, right, top, bottom = 720, 420, 70, 20, 40, 50
+    image = np.full((height, width, 3), 255, dtype=np.uint8)
+    curves = {name: sweep.f1_curve() for name, sweep in sweeps.items()}
+    values = np.concatenate([curve[np.isfinite(curve)] for curve in curves.values()] or [np.zeros(1)])
+    low = float(np.floor(min(values.min(initial=1.0), 0.9) * 20) / 20)
+
+    def point(x: float, value: float) -> tuple[int, int]:
+        return (int(round(left + (width - left - right) * x)),
+                int(round(top + (height - top - bottom) * (1.0 - (value - low) / (1.0 - low)))))
+
+    for tick in range(5):
+        value = low + (1.0 - low) * tick / 4
+        _, y = point(0.0, value)
+        cv2.line(image, (left, y), (width - right, y), _GREY, 1)
+        _text(image, f"{value:.3g}", (5, y + 4), 0.4)
+        x, _ = point(tick / 4, low)
+        _text(image, f"{tick / 4:g}", (x - 8, height - bottom + 18), 0.4)
+    cv2.rectangle(image, (left, top), (width - right, height - bottom), _BLACK, 1)
+    marker_x, _ = point(threshold, low)
+    cv2.line(image, (marker_x, top), (marker_x, height - bottom), _BLACK, 1)
+    _text(image, f"anchoring threshold {threshold:g}", (marker_x + 4, height - bottom - 6), 0.4)
+    for number, (name, sweep) in enumerate(sweeps.items()):
+        colour = _COLOURS[number % len(_COLOURS)]
+        curve, xs = curves[name], sweep.thresholds()
+        points = [point(x, max(v, low)) for x, v in zip(xs, curve, strict=True) if np.isfinite(v)]
+        for start, end in zip(points, points[1:], strict=False):
+            cv2.line(image, start, end, colour, 2, cv2.LINE_AA)
+        best_threshold, best = sweep.best()
+        if math.isfinite(best_threshold):
+            centre = point(best_threshold, max(best.f1, low))
+            cv2.circle(image, centre, 5, colour, -1, cv2.LINE_AA)
+            _text(image, f"{best.f1:.4f} at {best_threshold:.3f}", (centre[0] - 60, centre[1] - 10), 0.4, colour)
+        cv2.line(image, (left + 10 + 200 * number, 22), (left + 35 + 200 * number, 22), colour, 2)
+        _text(image, name, (left + 40 + 200 * number, 26))
+    _text(image, "pair F1 against the threshold", (left, 14), 0.5)
+    _text(image, "threshold", (width // 2 - 30, height - 10))
+    return _write(path, image)

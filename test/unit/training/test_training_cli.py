@@ -48,6 +48,15 @@ def test_train_then_evaluate_a_few_scenes(tmp_path, capsys) -> None:
                                                "rules searched", "network as run"}
     assert len(set(report["pairs"]) & replaced) in (0, 2)
     assert (tmp_path / "eval" / "confusion.png").is_file()
+    # The same pairs at every threshold: at the anchoring threshold, the very counts of the table.
+    sweeps = report["threshold_sweep"]
+    assert set(sweeps) == {"network", "rules", "network as run"}
+    for name in ("network", "rules"):
+        counts = ("true_positives", "false_positives", "false_negatives", "true_negatives")
+        assert [sweeps[name]["at_threshold"][key] for key in counts] == [report["pairs"][name][key] for key in counts]
+        assert sweeps[name]["best"]["f1"] >= report["pairs"][name]["f1"]
+    assert "every pair of Algorithm 3 again, at every threshold" in output
+    assert (tmp_path / "eval" / "threshold_sweep.png").is_file()
 
 
 def test_a_weights_file_that_does_not_exist_is_one_clear_error(tmp_path, capsys) -> None:
