@@ -111,8 +111,7 @@ def plot_threshold_sweeps(path: str | Path, sweeps: Mapping[str, ThresholdSweep]
     width, height, left, right, top, bottom = 720, 420, 70, 20, 40, 50
     image = np.full((height, width, 3), 255, dtype=np.uint8)
     curves = {name: sweep.f1_curve() for name, sweep in sweeps.items()}
-    values = np.concatenate([curve[np.isfinite(curve)] for curve in curves.values()] or [np.zeros(1)])
-    low = float(np.floor(min(values.min(initial=1.0), 0.9) * 20) / 20)
+    low = 0.5  # below, a curve only says "everything taken for the same" or "nothing": drawn at the floor
 
     def point(x: float, value: float) -> tuple[int, int]:
         return (int(round(left + (width - left - right) * x)),
@@ -136,12 +135,13 @@ def plot_threshold_sweeps(path: str | Path, sweeps: Mapping[str, ThresholdSweep]
         for start, end in zip(points, points[1:], strict=False):
             cv2.line(image, start, end, colour, 2, cv2.LINE_AA)
         best_threshold, best = sweep.best()
+        label = name
         if math.isfinite(best_threshold):
-            centre = point(best_threshold, max(best.f1, low))
-            cv2.circle(image, centre, 5, colour, -1, cv2.LINE_AA)
-            _text(image, f"{best.f1:.4f} at {best_threshold:.3f}", (centre[0] - 60, centre[1] - 10), 0.4, colour)
-        cv2.line(image, (left + 10 + 200 * number, 22), (left + 35 + 200 * number, 22), colour, 2)
-        _text(image, name, (left + 40 + 200 * number, 26))
+            cv2.circle(image, point(best_threshold, max(best.f1, low)), 5, colour, -1, cv2.LINE_AA)
+            label += f": best {best.f1:.4f} at {best_threshold:.3f}"
+        legend_y = height - bottom - 30 - 18 * (len(sweeps) - 1 - number)
+        cv2.line(image, (width - right - 300, legend_y - 4), (width - right - 275, legend_y - 4), colour, 2)
+        _text(image, label, (width - right - 270, legend_y), 0.4)
     _text(image, "pair F1 against the threshold", (left, 14), 0.5)
     _text(image, "threshold", (width // 2 - 30, height - 10))
     return _write(path, image)
