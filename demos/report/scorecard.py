@@ -230,9 +230,9 @@ def _said_indistinguishable(anchor: AnchorRecord, by_symbol: Mapping[str, Anchor
     """Whether ``anchor`` is one the anchoring layer left undecided: missing and named as not to be
     told from an anchor of its class that stands for an object of the world.
 
-    Twins found where the camera never looked cannot be told apart by any evidence (the issue asks
-    the robot to say so, not guess), so the sought anchor stays missing beside its candidate's; it
-    is a doubt stated, not an object silently anchored twice. A named partner that anchors nothing,
+    Twins found where the camera never looked cannot be told apart by any evidence, and the robot
+    says so rather than guess, so the sought anchor stays missing beside its candidate's: a doubt
+    stated, not an object silently anchored twice. A named partner that anchors nothing,
     or of another class, does not excuse it.
     """
     return any(symbol in matched and by_symbol[symbol].class_name == anchor.class_name
