@@ -159,6 +159,7 @@ def run_scenarios(arguments: argparse.Namespace) -> int:
     """Every requested scenario once per seed (or the soak's runs), one after another, then the
     table (and the soak's summary)."""
     from merlin2_sailor.anchoring.matcher_registry import MatcherSettings
+    from merlin2_sailor_demos.dds_domains import claimed_domain
     from merlin2_sailor_demos.report.scenario_table import to_markdown, to_text, write_table
     from merlin2_sailor_demos.report.soak_summary import SoakSummary, write_soak
     from merlin2_sailor_demos.scenario_runner import (
@@ -192,12 +193,13 @@ def run_scenarios(arguments: argparse.Namespace) -> int:
     runs = []
     for index, (entry, seed) in enumerate(plan):
         folder = output / "runs" / f"{entry.name}-seed{seed}-{matcher}"
-        domain = DOMAINS[(os.getpid() + index) % len(DOMAINS)]
-        options = RunOptions(seed=seed, matcher=arguments.matcher, deadline=arguments.deadline,
-                             grace_period=arguments.grace_period, domain=domain)
-        print(f"[{index + 1}/{len(plan)}] {entry.name} seed {seed} {matcher}: running in {folder} "
-              f"(ROS_DOMAIN_ID {domain})", flush=True)
-        done = run_scenario(entry, folder, options, matcher, echo=sys.stdout if len(plan) == 1 else None, stop=stop)
+        with claimed_domain(DOMAINS, os.getpid() + index) as domain:
+            options = RunOptions(seed=seed, matcher=arguments.matcher, deadline=arguments.deadline,
+                                 grace_period=arguments.grace_period, domain=domain)
+            print(f"[{index + 1}/{len(plan)}] {entry.name} seed {seed} {matcher}: running in {folder} "
+                  f"(ROS_DOMAIN_ID {domain})", flush=True)
+            done = run_scenario(entry, folder, options, matcher, echo=sys.stdout if len(plan) == 1 else None,
+                                stop=stop)
         runs.append(done)
         print(done.progress_line(index + 1, len(plan)), flush=True)
         if stop.is_set():
