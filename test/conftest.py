@@ -1,7 +1,7 @@
 """Test-wide set-up: isolate ROS traffic to this run, and offer a probe into the ROS graph.
 
 The environment is set before any test imports rclpy: DDS discovery stays on loopback, each run
-gets its own ROS_DOMAIN_ID (so parallel runs on one machine never see each other's nodes), logs
+gets its own ROS_DOMAIN_ID, locked while it runs (so parallel runs on one machine never see each other's nodes), logs
 go to a temporary folder, and Fast DDS uses the project's profile, as ``sailor launch`` does.
 Child processes started by the tests inherit all of it.
 """
@@ -25,6 +25,7 @@ from typing import Any
 import pytest
 
 from merlin2_sailor.inference.model_cache import cache_folder
+from merlin2_sailor_demos.dds_domains import claimed_domain
 
 REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
 
@@ -39,9 +40,15 @@ def _worker_index() -> int | None:
 
 # One ROS domain per run, and one per worker within it: the workers inherit the controller's
 # domain (set when it loaded this file) and step off it, so two runs, or two workers, never meet.
-os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
-if _worker_index() is not None:
-    os.environ["ROS_DOMAIN_ID"] = str(1 + (int(os.environ["ROS_DOMAIN_ID"]) - 1 + _worker_index() + 1) % 101)
+# Each holds a lock on its domain for the life of its process, as every run of `sailor demo`
+# does (merlin2_sailor_demos.dds_domains), so neither another test run nor a demo started by a
+# test (or beside the tests) lands in it.
+_DOMAINS = range(1, 101)
+if "ROS_DOMAIN_ID" not in os.environ or _worker_index() is not None:
+    _inherited = os.environ.get("ROS_DOMAIN_ID", "")
+    _first = (int(_inherited) - 1 + _worker_index() + 1) if _inherited.isdigit() else os.getpid()
+    _DOMAIN_CLAIM = claimed_domain(_DOMAINS, _first)
+    os.environ["ROS_DOMAIN_ID"] = str(_DOMAIN_CLAIM.__enter__())  # released when the process ends
 os.environ.setdefault("ROS_LOG_DIR", tempfile.mkdtemp(prefix="sailor-test-ros-logs-"))
 os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "config" / "fastdds.xml"))
 os.environ.setdefault("RCUTILS_COLORIZED_OUTPUT", "0")
