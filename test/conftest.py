@@ -1,8 +1,9 @@
 """Test-wide set-up: isolate ROS traffic to this run, and offer a probe into the ROS graph.
 
 The environment is set before any test imports rclpy: DDS discovery stays on loopback, each run
-gets its own ROS_DOMAIN_ID, locked while it runs (so parallel runs on one machine never see each other's nodes), logs
-go to a temporary folder, and Fast DDS uses the project's profile, as ``sailor launch`` does.
+gets its own ROS_DOMAIN_ID, locked while it runs (so parallel runs on one machine never see each
+other's nodes), logs go to a temporary folder, and Fast DDS uses the project's profile, as
+``sailor launch`` does.
 Child processes started by the tests inherit all of it.
 """
 
