@@ -23,6 +23,8 @@ from typing import IO
 
 from merlin2_sailor.errors import ConfigurationError
 
+#: DDS domains runs may use (1-100: the range that is safe on Linux; 0 is left to the user).
+DOMAINS = range(1, 101)
 #: Where the lock files live: one folder per machine, shared by its users (DDS domains are too).
 LOCK_FOLDER = Path(tempfile.gettempdir()) / "sailor-dds-domains"
 

@@ -38,8 +38,6 @@ FAST_DDS_PROFILE_VARIABLE = "FASTRTPS_DEFAULT_PROFILES_FILE"
 DOMAIN_VARIABLE = "ROS_DOMAIN_ID"
 #: The nodes of launch/demo.yaml the overrides go to.
 WORLD_NODE, ANCHORING_NODE, MISSION_NODE = "world", "anchoring", "mission_demo"
-#: DDS domains the runs use, in turn (1-100: the range that is safe on Linux; 0 is left to the user).
-DOMAINS = range(1, 101)
 
 
 @dataclass(frozen=True)

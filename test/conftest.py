@@ -26,7 +26,7 @@ from typing import Any
 import pytest
 
 from merlin2_sailor.inference.model_cache import cache_folder
-from merlin2_sailor_demos.dds_domains import claimed_domain
+from merlin2_sailor_demos.dds_domains import DOMAINS, claimed_domain
 
 REPOSITORY_ROOT = Path(__file__).resolve().parent.parent
 
@@ -44,11 +44,10 @@ def _worker_index() -> int | None:
 # Each holds a lock on its domain for the life of its process, as every run of `sailor demo`
 # does (merlin2_sailor_demos.dds_domains), so neither another test run nor a demo started by a
 # test (or beside the tests) lands in it.
-_DOMAINS = range(1, 101)
 if "ROS_DOMAIN_ID" not in os.environ or _worker_index() is not None:
     _inherited = os.environ.get("ROS_DOMAIN_ID", "")
     _first = (int(_inherited) - 1 + _worker_index() + 1) if _inherited.isdigit() else os.getpid()
-    _DOMAIN_CLAIM = claimed_domain(_DOMAINS, _first)
+    _DOMAIN_CLAIM = claimed_domain(DOMAINS, _first)
     os.environ["ROS_DOMAIN_ID"] = str(_DOMAIN_CLAIM.__enter__())  # released when the process ends
 os.environ.setdefault("ROS_LOG_DIR", tempfile.mkdtemp(prefix="sailor-test-ros-logs-"))
 os.environ.setdefault("FASTRTPS_DEFAULT_PROFILES_FILE", str(REPOSITORY_ROOT / "config" / "fastdds.xml"))

@@ -159,12 +159,11 @@ def run_scenarios(arguments: argparse.Namespace) -> int:
     """Every requested scenario once per seed (or the soak's runs), one after another, then the
     table (and the soak's summary)."""
     from merlin2_sailor.anchoring.matcher_registry import MatcherSettings
-    from merlin2_sailor_demos.dds_domains import claimed_domain
+    from merlin2_sailor_demos.dds_domains import DOMAINS, claimed_domain
     from merlin2_sailor_demos.report.scenario_table import to_markdown, to_text, write_table
     from merlin2_sailor_demos.report.soak_summary import SoakSummary, write_soak
     from merlin2_sailor_demos.scenario_runner import (
         ANCHORING_NODE,
-        DOMAINS,
         WORLD_NODE,
         RunOptions,
         demo_launch,
