@@ -49,9 +49,10 @@ from merlin2_sailor.anchoring.matching_table import (
     held_views,
     with_embeddings,
 )
-from merlin2_sailor.anchoring.merge import apply_decision, withdraw_stale_ambiguities
+from merlin2_sailor.anchoring.merge import apply_decision, join_parts, withdraw_stale_ambiguities
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
+from merlin2_sailor.anchoring.parts import decide_parts, note_seen_together
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
 from merlin2_sailor.anchoring.place_return import Return, decide_returns, note_jump
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
@@ -278,6 +279,7 @@ class Anchoring:
             # An anchor a far view may have been is not unseen: whether it was there cannot be told.
             told_apart = seen | {anchor.symbol for anchor in unresolved.values()}
             check_unseen(self._index, camera, told_apart, changes, config.visibility, config.lifecycle)
+        note_seen_together((anchor for anchor in map(self._index.get, seen) if anchor is not None), self._index)
         renamed = self._repair_identities(changes)
         if changes.forgotten:
             withdraw_stale_ambiguities(self._index)
@@ -412,6 +414,12 @@ class Anchoring:
     def _repair_identities(self, changes: FrameChanges) -> dict[str, str]:
         """Apply identity repair after a frame; return {merged symbol: kept symbol}."""
         repair = self.config.repair
+        # Parts of one object are joined first: the other rules then judge the object, not its parts.
+        renamed: dict[str, str] = {}
+        for parts in decide_parts(list(changes.reacquired), self._index, repair.part_slack, self.config.colour):
+            if parts.kept.symbol in self._index and parts.part.symbol in self._index:
+                join_parts(parts, self._index, changes, self.config.fusion)
+                renamed[parts.part.symbol] = parts.kept.symbol
         # A jump undone comes first: the anchors it swaps back are then judged in their right places.
         decisions: list[Decision | Duplicate | Return | None] = list(decide_returns(
             changes.acquired, self._index, changes.stamp, repair.place_jump, repair.place_review, self.config.colour))
@@ -427,7 +435,8 @@ class Anchoring:
         grown = [anchor for anchor in changes.reacquired
                  if colour_evidence_grew(anchor.colour, self.config.colour.minimum_views)
                  or sightings_doubled(anchor, self.config.lifecycle)]
-        judged = [*changes.confirmed_newcomers, *grown]
+        joined = [self._index.get(symbol) for symbol in dict.fromkeys(renamed.values())]
+        judged = [*changes.confirmed_newcomers, *grown, *(anchor for anchor in joined if anchor is not None)]
         decisions.extend(self._repair.decide_reappearances(changes.missing, judged, self._index))
         decisions.extend(self._repair.decide_relocations(changes.missing, judged, self._index))
         decisions.extend(decide_same_space(changes.reacquired, self._index, self.config.repair.same_space_overlap,
@@ -438,7 +447,6 @@ class Anchoring:
             for sought in self._index.expected():
                 if sought.expectation is not None and sought.expectation.is_search:
                     decisions.append(self._repair.decide_search(sought, sought.expectation, self._index))
-        renamed: dict[str, str] = {}
         for decision in decisions:
             if any(anchor.symbol not in self._index for anchor in _involved(decision)):
                 continue  # an earlier decision of this frame already merged or forgot one of them
@@ -448,7 +456,7 @@ class Anchoring:
             elif isinstance(decision, Return):  # this frame's percepts swap symbols too
                 renamed[decision.anchor.symbol] = decision.newcomer.symbol
                 renamed[decision.newcomer.symbol] = decision.anchor.symbol
-        return renamed
+        return _settled(renamed)
 
     def _move_to_expected(self, anchor: Anchor, position: np.ndarray) -> None:
         anchor.position = np.asarray(position, dtype=np.float64)
@@ -465,6 +473,20 @@ class Anchoring:
         if anchor is None:
             raise InvalidInputError(f"No anchor is named {symbol!r}; it was never acquired or has been forgotten.")
         return anchor
+
+
+def _settled(renamed: dict[str, str]) -> dict[str, str]:
+    """Each renamed symbol to the symbol it ends under, when a frame merged it twice (a part joined
+    to an anchor that a search then took for the anchor it sought). A swap (two symbols renamed to
+    each other) is left as it is."""
+    settled = dict(renamed)
+    for symbol, target in renamed.items():
+        hops = 0
+        while target in renamed and renamed[target] != symbol and hops < len(renamed):
+            target = renamed[target]
+            hops += 1
+        settled[symbol] = target
+    return settled
 
 
 def _involved(decision: Decision | Duplicate | Return | None) -> tuple[Anchor, ...]:

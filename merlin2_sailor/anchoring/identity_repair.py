@@ -71,7 +71,9 @@ class RepairConfig:
     0 turns reappearance merges off); ``ambiguity_margin``: how much better than every rival a
     candidate must score to be taken (scores closer than this cannot tell the two apart);
     ``same_space_overlap``: the share of the smaller 3D box two anchors of a class must have in
-    common to be one object (:mod:`.same_space`; 0 turns that off); ``stand_in_distance`` (m): how
+    common to be one object (:mod:`.same_space`; 0 turns that off); ``part_slack``: the share by which
+    the box around two anchors of a large object's class may exceed the largest one of the class
+    seen whole for them to be parts of one object (:mod:`.parts`; 0 turns that off); ``stand_in_distance`` (m): how
     close to an anchor that was away a newcomer seen only meanwhile must stand to be it, seen off its
     place (:mod:`.stand_in`; 0 turns that off); ``place_jump`` (m): how far from a
     place an anchor must have gone, by a sudden move, for a newcomer on that place to show that the
@@ -84,6 +86,7 @@ class RepairConfig:
     reappearance_distance: float = 0.25
     ambiguity_margin: float = 0.15
     same_space_overlap: float = 0.5
+    part_slack: float = 0.25
     stand_in_distance: float = 0.25
     place_jump: float = 0.15
     place_review: float = 2.0
@@ -112,6 +115,8 @@ class RepairConfig:
         if not (math.isfinite(self.place_review) and self.place_review >= 0.0):
             raise ConfigurationError(f"anchoring place_review must be a non-negative number of seconds, "
                                      f"got {self.place_review}.")
+        if not (0.0 <= self.part_slack <= 1.0):
+            raise ConfigurationError(f"anchoring part_slack must be in [0, 1] (0 turns it off), got {self.part_slack}.")
         if not (0.0 <= self.same_space_overlap <= 1.0):
             raise ConfigurationError(
                 f"anchoring same_space_overlap must be in [0, 1] (0 turns it off), got {self.same_space_overlap}."

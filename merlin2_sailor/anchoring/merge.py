@@ -5,18 +5,21 @@ the kept anchor takes the merged one's views, sightings and class votes, and, wh
 was found elsewhere, its place. An undecided case changes no identity: each lost anchor records
 what it cannot be told from, and an AMBIGUOUS event says so. A duplicate (:mod:`.same_space`) is
 forgotten, its object keeping the other symbol. A jump undone (:mod:`.place_return`) trades the
-two anchors' places, so each symbol is back on its own object.
+two anchors' places, so each symbol is back on its own object. Parts of one object (:mod:`.parts`)
+become one anchor, the older, whose box is the box around both.
 """
 
 from __future__ import annotations
 
-from merlin2_sailor.anchoring.anchor import AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, Merge
 from merlin2_sailor.anchoring.observation import drop_expectation
+from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS
+from merlin2_sailor.anchoring.parts import Parts, is_part
 from merlin2_sailor.anchoring.percept_checks import position_text
 from merlin2_sailor.anchoring.place_return import Return, trade_places
 from merlin2_sailor.anchoring.same_space import Duplicate
@@ -33,11 +36,67 @@ def withdraw_stale_ambiguities(index: AnchorIndex) -> None:
             anchor.indistinguishable_from = ()
 
 
+def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig) -> None:
+    """Make two parts of one object one anchor: the older symbol, the views of both, and the box of
+    the whole one where one of them is whole, else the box around both.
+
+    One of the two was seen in this frame, so the object is: the anchor is confirmed and visible.
+    A part's appearance views are dropped (:mod:`.parts` says why). A box around parts holds later
+    views as an extent seen whole does (:data:`.partial_view.EXTENT_CORROBORATING_VIEWS` whole views'
+    worth): a later view of a part, even one no test saw cut, keeps the anchor alive without moving
+    it (:func:`.partial_view.smaller_than_known`). Without that, views of the bicycle's far end that
+    nothing showed cut pulled the joined anchor 0.6 m onto that end (scenario suite, 6 December 2026).
+    It keeps the extent it was fit in (``parts_fit``): later views of parts beyond the box widen it
+    within that, and it is never the extent that joins are judged by, so joins cannot widen the
+    class's known extent step by step."""
+    kept, part = decision.kept, decision.part
+    whole = next((anchor for anchor in (kept, part)
+                  if not is_part(anchor, decision.known) and anchor.parts_fit is None), None)
+    for anchor in (kept, part):
+        if is_part(anchor, decision.known):  # its views are of a part, not of the object (see parts)
+            anchor.gallery = anchor.gallery_scales = None
+    box = (whole.position.copy(), whole.size.copy(), whole.whole_views, whole.parts_fit) if whole is not None else (
+        (decision.low + decision.high) / 2.0, decision.high - decision.low, EXTENT_CORROBORATING_VIEWS, decision.fit)
+    kept.absorb_anchor(part, fusion, moved=False)
+    _hand_over_sightings(kept, part, index)
+    index.remove(part.symbol)
+    part.visible = False
+    part.state = AnchorState.FORGOTTEN
+    kept.position, kept.size, kept.whole_views, kept.parts_fit = box
+    kept.perceived_position = kept.position.copy()
+    kept.visible = True
+    was_missing = kept.state is AnchorState.MISSING
+    kept.state = AnchorState.CONFIRMED
+    kept.missing_since = kept.lost_after = kept.lost_at = None
+    kept.missed_frames = kept.recovery_sightings = 0
+    kept.indistinguishable_from = ()
+    index.refresh(kept)
+    changes.forgotten.append(part)
+    if kept not in changes.reacquired:
+        changes.reacquired.append(kept)
+    changes.event(AnchorEventKind.FORGOTTEN, part.symbol, reason=f"{decision.reason}: it is {kept.symbol}")
+    changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=decision.reason, merged=part.symbol,
+                  was_missing=was_missing, at=position_text(kept.position))
+
+
+def _hand_over_sightings(kept: Anchor, merged: Anchor, index: AnchorIndex) -> None:
+    """Anchors seen at one time with the merged anchor were seen with the kept one's object."""
+    for anchor in index.of_class(merged.class_name):
+        if merged.symbol in anchor.seen_with:
+            anchor.seen_with.discard(merged.symbol)
+            if anchor is not kept:
+                anchor.seen_with.add(kept.symbol)
+
+
 def apply_decision(
-    decision: Decision | Duplicate | Return | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig
+    decision: Decision | Duplicate | Return | Parts | None, index: AnchorIndex, changes: FrameChanges,
+    fusion: FusionConfig,
 ) -> None:
-    """Carry out a merge, forget a duplicate, undo a jump, or report what could not be decided."""
+    """Carry out a merge, forget a duplicate, undo a jump, join parts, or report what could not be decided."""
     if decision is None:
+        return
+    if isinstance(decision, Parts):
+        join_parts(decision, index, changes, fusion)
         return
     if isinstance(decision, Return):
         anchor, newcomer = decision.anchor, decision.newcomer
@@ -52,6 +111,7 @@ def apply_decision(
         return
     if isinstance(decision, Duplicate):
         duplicate = decision.duplicate
+        _hand_over_sightings(decision.kept, duplicate, index)
         index.remove(duplicate.symbol)
         duplicate.visible = False
         duplicate.state = AnchorState.FORGOTTEN
@@ -77,6 +137,7 @@ def apply_decision(
     still_missing = merged.state is AnchorState.MISSING
     was_visible = merged.visible
     kept.absorb_anchor(merged, fusion, decision.moved)
+    _hand_over_sightings(kept, merged, index)
     index.remove(merged.symbol)
     merged.visible = False
     kept.visible = was_visible

@@ -364,6 +364,11 @@ SETTINGS: tuple[Setting, ...] = (
                 "Share of the smaller 3D box that a missing anchor and an anchor of its class seen in its "
                 "place must have in common to be one object (two objects cannot fill one space): the younger "
                 "is a second anchor left by a slip, and goes (0 turns it off).", 0.0, 1.0),
+        Setting("part_slack", ("core", "repair", "part_slack"),
+                "Share by which the box around two anchors of a large object's class, never seen at one "
+                "time, one of them a part, may exceed the largest one of the class seen whole for them to "
+                "be parts of one object, seen in pieces: the younger goes into the older (0 turns it off).",
+                0.0, 1.0),
         Setting("stand_in_distance", ("core", "repair", "stand_in_distance"),
                 "How close (m) to an anchor that was away a newcomer of its class, seen only while it was "
                 "away and gone as it came back, must stand to be that anchor seen off its place (a pose "

@@ -77,6 +77,8 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "expectation_confirmed": bool(anchor.expectation_confirmed),
         "indistinguishable_from": list(anchor.indistinguishable_from),
         "watched_before": int(anchor.watched_before),
+        "seen_with": sorted(anchor.seen_with),
+        "parts_fit": None if anchor.parts_fit is None else anchor.parts_fit.tolist(),
     }
 
 
@@ -117,6 +119,8 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             expectation_confirmed=bool(data.get("expectation_confirmed", False)),
             indistinguishable_from=tuple(str(symbol) for symbol in data.get("indistinguishable_from") or ()),
             watched_before=int(data.get("watched_before", 0)),
+            seen_with={str(symbol) for symbol in data.get("seen_with") or ()},
+            parts_fit=None if data.get("parts_fit") is None else _vector(data["parts_fit"], "parts_fit"),
         )
     except (KeyError, ValueError, TypeError) as error:
         name = data.get("symbol", "?") if isinstance(data, Mapping) else "?"

@@ -22,6 +22,7 @@ from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
+from merlin2_sailor.knowledge.model import Provenance
 
 from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, camera_view, flat_depth
 
@@ -270,3 +271,21 @@ def test_one_box_around_two_neighbours_does_not_make_their_views_its_parts(maker
     assert mug_anchor.state is AnchorState.CONFIRMED
     assert [anchor.symbol for anchor in anchoring.anchors if anchor.state is AnchorState.CONFIRMED] == [
         mug_anchor.symbol]
+
+
+def test_a_partial_view_moves_an_anchor_that_stands_where_an_expectation_put_it(maker) -> None:
+    """Perception outranks expectation: a search put the anchor in the middle of its disc, and the
+    first view of the object there is of a part; it must move the anchor, though a partial view of
+    an anchor seen whole would not."""
+    config = AnchoringConfig().fusion
+    anchor = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), None, config)
+    anchor.whole_views = 5
+    part = view_of(maker, BICYCLE, 1.0, EDGE_BOX, centre=(3.0, 2.5, 0.5), size=(0.35, 0.5, 1.0))
+    anchor.absorb(part, None, config, partial=True)
+    assert np.linalg.norm(anchor.position[:2] - np.array((3.0, 0.0))) < 0.05  # perceived: a part does not move it
+
+    anchor.position = np.array((5.0, 5.0, 0.5))  # where a search's disc is centred
+    anchor.position_variance = 1.0
+    anchor.provenance = Provenance.EXPECTED
+    anchor.absorb(part, None, config, partial=True)
+    assert np.linalg.norm(anchor.position[:2] - np.array((3.0, 2.5))) < 0.05

@@ -1,0 +1,165 @@
+"""Two anchors of a large object's class that are parts of one object: the camera saw it in pieces.
+
+A bicycle first seen where it was wheeled to, past a door frame, from its side, close up, shows
+the camera a wheel, then its middle, then its other end: each view is a part, its box a third of
+the bicycle, its crop unlike the others, and a view that falls far enough from the part anchored
+before it is anchored anew. Nothing else joins such anchors: they are both confirmed (the
+reappearance and same-space rules join a MISSING anchor with one seen in its place), no view of
+either is comparable by its look with the other's (:func:`~.partial_view.comparable_views`), and
+the matching function scores a part's view low against another part (0.03-0.46 for the bicycle
+of `large_object_wheeled_away`, scenario suite, 5 December 2026: three confirmed anchors 0.5-1.3 m
+apart, and a search for the bicycle then said it "cannot tell" them apart, where the truth was one
+bicycle).
+
+Two parts of one object differ from two objects by evidence of space and time, not of look:
+
+- **they fit inside one object**: the box around both fits, side by side, within the largest
+  extent the robot has seen whole of their class (an anchor of the class with at least
+  :data:`~.partial_view.EXTENT_CORROBORATING_VIEWS` whole views, as :mod:`.partial_view` asks
+  before a view is called a part), with a share ``slack`` more for the noise of boxes (a part's
+  box, centred on what the depth camera saw of it, reaches past the object by a few decimetres). Two whole bicycles
+  side by side, or two cats nose to tail, make a box larger than one: they are never joined.
+  Where the robot has not seen a whole one of the class, nothing is joined: there is no evidence
+  of how large one is;
+- **one of them, at least, is a part**: its footprint is clearly less than the whole one's (under
+  :data:`~.partial_view.PARTIAL_FOOTPRINT_SHARE` of it, as :mod:`.partial_view` tells a partial
+  view). Two anchors of whole views are the matching function's to tell apart, not this rule's;
+- **they were never seen at one time**: two anchors seen in one frame are two percepts, two
+  objects (every anchor keeps the symbols of anchors of its class seen in a frame with it,
+  ``Anchor.seen_with``);
+- both are trusted (confirmed, or missing after that), nothing is expected of either (an
+  action's expectation or a search decides those), and their colours do not differ.
+
+The older symbol stays, as in every merge, and its box becomes the box around both: the object's
+extent as far as the parts show it, which later views of parts beyond it widen, within the whole
+one's extent (``Anchor.parts_fit``). The appearance views of a part are dropped: the partial-view
+tests let a part's views into its gallery when nothing showed them cut (the bicycle's far end,
+0.46 m of 1.6, seen whole five times), and a gallery of parts is evidence against the object
+itself: in the run above, the joined anchor's part views scored under the threshold against
+the bicycle's whole views, so a search did not take it. Without them the object is compared by
+class, place and time until whole views come.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, turned_extent
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
+from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS, PARTIAL_FOOTPRINT_SHARE
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Parts:
+    """``part`` (younger) and ``kept`` are parts of one object: ``kept`` takes ``part``'s views, and
+    its box becomes the box from ``low`` to ``high`` (world frame, m) around both; ``known`` is the
+    extent (:func:`~.anchor.turned_extent`) of the whole one of the class that the box fits in, and
+    ``fit`` that extent with the slack, the most the parts may fill."""
+
+    kept: Anchor
+    part: Anchor
+    low: np.ndarray
+    high: np.ndarray
+    known: np.ndarray
+    fit: np.ndarray
+
+    @property
+    def reason(self) -> str:
+        long_side, short_side, height = self.known
+        return (f"parts of one {self.kept.class_name}: together they fit within one seen whole "
+                f"({long_side:.2f} x {short_side:.2f} x {height:.2f} m) and were never seen at one time")
+
+
+def note_seen_together(anchors: Iterable[Anchor], index: AnchorIndex) -> None:
+    """Record, on each of ``anchors`` (those seen in one frame), the others of its class among them:
+    they are two objects. Symbols no longer anchored are dropped on the way, so the record stays as
+    small as the class's anchors."""
+    by_class: dict[str, list[Anchor]] = {}
+    for anchor in anchors:
+        by_class.setdefault(anchor.class_name, []).append(anchor)
+    for together in by_class.values():
+        if len(together) < 2:
+            continue
+        symbols = {anchor.symbol for anchor in together}
+        for anchor in together:
+            anchor.seen_with = {symbol for symbol in anchor.seen_with | symbols
+                                if symbol != anchor.symbol and symbol in index}
+
+
+def largest_seen_whole(index: AnchorIndex, class_name: str, slack: float) -> np.ndarray | None:
+    """The extent (:func:`~.anchor.turned_extent`; m) of the largest whole one of the class the robot
+    has seen, if it is of a large object; else None. An anchor known from enough whole views counts
+    by its box; one whose box was joined from parts, by the whole one its parts were fit in
+    (``parts_fit``, less the ``slack``), never by its own box: a search that merges the joined anchor
+    into the one it sought takes that box and forgets its own whole extent, and the class's extent
+    must not be lost with it, nor widened by joins step by step."""
+    known = None
+    for anchor in index.of_class(class_name):
+        if anchor.parts_fit is not None:
+            extent = anchor.parts_fit / (1.0 + slack)
+        elif anchor.whole_views >= EXTENT_CORROBORATING_VIEWS:
+            extent = turned_extent(anchor.size)
+        else:
+            continue
+        if extent[0] > SMALL_OBJECT_EXTENT and (known is None or extent[0] > known[0]):
+            known = extent
+    return known
+
+
+def decide_parts(seen: Sequence[Anchor], index: AnchorIndex, slack: float,
+                 colour: ColourEvidenceConfig) -> list[Parts]:
+    """Decisions joining each trusted anchor ``seen`` this frame with one other anchor of its class
+    that is another part of its object (``slack``: the share by which the box around both may exceed
+    the whole one's extent; 0 turns the rule off). At most one per anchor
+    and frame: the next frame judges the grown box again."""
+    if slack <= 0.0:
+        return []
+    decisions: list[Parts] = []
+    settled: set[str] = set()
+    for anchor in seen:
+        if anchor.symbol in settled or not _trusted(anchor):
+            continue
+        known = largest_seen_whole(index, anchor.class_name, slack)
+        if known is None:
+            continue
+        fit = known * (1.0 + slack)
+        slots = index.within(anchor.position.reshape(1, 3), float(fit[0]))[0]
+        others = sorted((other for other in index.anchors_at(slots) if other.symbol not in settled
+                         and _may_be_parts(anchor, other, colour)), key=lambda other: other.first_seen)
+        for other in others:
+            low = np.minimum(anchor.position - anchor.size / 2.0, other.position - other.size / 2.0)
+            high = np.maximum(anchor.position + anchor.size / 2.0, other.position + other.size / 2.0)
+            fits = bool(np.all(turned_extent(high - low) <= fit))
+            if not fits or not (is_part(anchor, known) or is_part(other, known)):
+                continue
+            kept, part = (anchor, other) if anchor.first_seen <= other.first_seen else (other, anchor)
+            decisions.append(Parts(kept, part, low, high, known, fit))
+            settled.update((anchor.symbol, other.symbol))
+            break
+    return decisions
+
+
+def is_part(anchor: Anchor, known: np.ndarray) -> bool:
+    """Whether the anchor's footprint is clearly less than the whole one's ``known`` extent (as
+    :mod:`.partial_view` tells a part)."""
+    return turned_extent(anchor.size)[0] < PARTIAL_FOOTPRINT_SHARE * known[0]
+
+
+def _trusted(anchor: Anchor) -> bool:
+    return anchor.state in (AnchorState.CONFIRMED, AnchorState.MISSING) and anchor.expectation is None
+
+
+def _may_be_parts(anchor: Anchor, other: Anchor, colour: ColourEvidenceConfig) -> bool:
+    return (
+        other is not anchor
+        and other.class_name == anchor.class_name
+        and _trusted(other)
+        and other.symbol not in anchor.seen_with
+        and anchor.symbol not in other.seen_with
+        and not colours_differ(anchor.colour, other.colour, colour)
+    )

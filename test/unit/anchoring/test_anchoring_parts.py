@@ -1,0 +1,208 @@
+"""Anchors of a large object seen in pieces are joined into one; two objects never are.
+
+The case comes from the scenario suite: a bicycle wheeled into another room was seen there only
+in parts (a wheel, its middle, its far end), each part anchored anew, three confirmed anchors of
+one bicycle. Tested on a bicycle seen whole once and then in parts elsewhere, on parts joined
+step by step, and on what must stay two objects: two bicycles side by side or end to end, parts
+seen at one time, another colour, no whole one ever seen, small objects, and a box built from
+parts taken as the extent of its class.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_index import AnchorIndex
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
+from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.identity_repair import RepairConfig
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
+from merlin2_sailor.anchoring.parts import Parts, decide_parts, largest_seen_whole
+from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
+from merlin2_sailor.errors import ConfigurationError
+
+from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, mug_colour
+
+FRAME = 1.0 / 15.0
+BICYCLE = np.array((0.35, 1.6, 1.0))
+PART = np.array((0.35, 0.45, 1.0))
+COLOUR = ColourEvidenceConfig()
+SLACK = RepairConfig().part_slack
+
+
+def bicycle(symbol: str, y: float, size: np.ndarray = PART, first_seen: float = 10.0, x: float = 3.0,
+            state: AnchorState = AnchorState.CONFIRMED, whole_views: int = 0, hue: int | None = None) -> Anchor:
+    position = np.array((x, y, 0.5))
+    anchor = Anchor(symbol, "bicycle", position, np.asarray(size, dtype=np.float64).copy(), first_seen,
+                    first_seen + 1.0, state=state, whole_views=whole_views, perceived_position=position.copy())
+    anchor.visible = state is AnchorState.CONFIRMED
+    if hue is not None:
+        anchor.colour = ColourModel.of(mug_colour(hue, share=0.6))
+        for _ in range(4):
+            anchor.colour.add(mug_colour(hue, share=0.6))
+    return anchor
+
+
+def seen_whole_elsewhere(symbol: str = "bicycle_1") -> Anchor:
+    """The bicycle as the robot knew it before it was moved: seen whole, many times, now missing."""
+    return bicycle(symbol, -5.0, BICYCLE, first_seen=0.0, state=AnchorState.MISSING, whole_views=20)
+
+
+def decide(*anchors: Anchor, slack: float = SLACK) -> list[Parts]:
+    index = AnchorIndex()
+    for anchor in anchors:
+        index.add(anchor)
+    return decide_parts([anchor for anchor in anchors if anchor.visible], index, slack, COLOUR)
+
+
+def test_two_parts_inside_one_bicycle_are_joined_into_the_older_with_the_box_around_both():
+    front = bicycle("bicycle_2", 3.40, first_seen=10.0)
+    rear = bicycle("bicycle_3", 4.55, first_seen=20.0)
+    [parts] = decide(seen_whole_elsewhere(), front, rear)
+    assert (parts.kept, parts.part) == (front, rear)
+    np.testing.assert_allclose(parts.high - parts.low, (0.35, 1.6, 1.0), atol=1e-9)
+    np.testing.assert_allclose(parts.known, (1.6, 0.35, 1.0))
+    assert "parts of one bicycle" in parts.reason
+
+
+def test_a_part_beside_a_whole_view_of_the_same_size_is_joined_and_the_whole_box_is_the_object():
+    """A whole television, and a part of it anchored anew past a door frame."""
+    whole = bicycle("bicycle_2", 4.0, BICYCLE, first_seen=10.0, whole_views=6)
+    part = bicycle("bicycle_3", 4.5, first_seen=20.0)
+    [parts] = decide(whole, part)
+    assert (parts.kept, parts.part) == (whole, part)
+
+
+@pytest.mark.parametrize(
+    "second, why",
+    [
+        (bicycle("bicycle_3", 5.40, first_seen=20.0), "end to end: the box around both is 2.45 m"),
+        (bicycle("bicycle_3", 3.40, first_seen=20.0, x=3.6), "side by side: 0.95 m wide"),
+        (bicycle("bicycle_3", 3.90, BICYCLE, first_seen=20.0, whole_views=5, x=3.5), "a whole one beside it"),
+    ],
+)
+def test_two_bicycles_are_never_joined(second: Anchor, why: str):
+    first = bicycle("bicycle_2", 3.40, first_seen=10.0)
+    assert decide(seen_whole_elsewhere(), first, second) == [], why
+
+
+def test_parts_seen_at_one_time_are_two_objects():
+    front = bicycle("bicycle_2", 3.40, first_seen=10.0)
+    rear = bicycle("bicycle_3", 4.55, first_seen=20.0)
+    front.seen_with.add("bicycle_3")
+    assert decide(seen_whole_elsewhere(), front, rear) == []
+
+
+def test_no_join_without_a_whole_one_of_the_class_seen_or_with_the_rule_off():
+    front = bicycle("bicycle_2", 3.40, first_seen=10.0)
+    rear = bicycle("bicycle_3", 4.55, first_seen=20.0)
+    assert decide(front, rear) == []  # how large is a bicycle? nothing seen says
+    once = seen_whole_elsewhere()
+    once.whole_views = 1  # one box may be a detector's slip around two neighbours
+    assert decide(once, front, rear) == []
+    assert decide(seen_whole_elsewhere(), front, rear, slack=0.0) == []
+
+
+def test_a_box_built_from_parts_is_not_the_extent_of_its_class_but_the_whole_one_it_was_fit_in_is():
+    """Its box (2.0 m, as wide as the slack let it grow) does not count; the 1.6 m bicycle its parts
+    were fit in does, though no anchor holds that bicycle's box any more (a search merged the joined
+    anchor into the one it sought, which took the joined box)."""
+    joined = bicycle("bicycle_2", 0.0, np.array((0.35, 2.0, 1.0)), first_seen=1.0, whole_views=2)
+    joined.parts_fit = BICYCLE[[1, 0, 2]] * (1.0 + SLACK)
+    index = AnchorIndex()
+    index.add(joined)
+    np.testing.assert_allclose(largest_seen_whole(index, "bicycle", SLACK), (1.6, 0.35, 1.0))
+    front = bicycle("bicycle_3", 3.40, first_seen=10.0)
+    assert decide(joined, front, bicycle("bicycle_4", 5.20, first_seen=20.0)) == []  # 2.25 m: too long
+    [parts] = decide(joined, front, bicycle("bicycle_4", 4.55, first_seen=20.0))
+    assert parts.kept is front
+
+
+def test_other_colours_an_expected_anchor_and_tentative_ones_are_left_alone():
+    red = bicycle("bicycle_2", 3.40, first_seen=10.0, hue=1)
+    blue = bicycle("bicycle_3", 4.55, first_seen=20.0, hue=8)
+    assert decide(seen_whole_elsewhere(), red, blue) == []
+    carried = bicycle("bicycle_2", 3.40, first_seen=10.0)
+    carried.expectation = Expectation.at(np.array((3.0, 3.4, 0.5)), 5.0, source="bring")
+    assert decide(seen_whole_elsewhere(), carried, bicycle("bicycle_3", 4.55, first_seen=20.0)) == []
+    tentative = bicycle("bicycle_3", 4.55, first_seen=20.0, state=AnchorState.TENTATIVE)
+    assert decide(seen_whole_elsewhere(), bicycle("bicycle_2", 3.40, first_seen=10.0), tentative) == []
+
+
+def test_small_objects_are_never_joined_as_parts():
+    def mug(symbol: str, y: float, first_seen: float, whole_views: int = 0) -> Anchor:
+        anchor = bicycle(symbol, y, np.array((0.1, 0.1, 0.11)), first_seen=first_seen, whole_views=whole_views)
+        anchor.class_name = "cup"
+        return anchor
+
+    assert decide(mug("cup_1", 0.0, 0.0, whole_views=9), mug("cup_2", 3.0, 10.0), mug("cup_3", 3.05, 20.0)) == []
+
+
+def test_the_setting_is_checked():
+    with pytest.raises(ConfigurationError, match="part_slack"):
+        RepairConfig(part_slack=-0.1)
+    with pytest.raises(ConfigurationError, match="part_slack"):
+        RepairConfig(part_slack=1.5)
+
+
+def test_what_was_seen_together_and_the_box_from_parts_survive_a_restart():
+    anchor = bicycle("bicycle_2", 3.4)
+    anchor.seen_with = {"bicycle_5", "bicycle_9"}
+    anchor.parts_fit = np.array((2.0, 0.44, 1.25))
+    restored = anchor_from_dict(anchor_to_dict(anchor))
+    assert restored.seen_with == {"bicycle_5", "bicycle_9"}
+    np.testing.assert_allclose(restored.parts_fit, (2.0, 0.44, 1.25))
+    assert anchor_from_dict(anchor_to_dict(bicycle("bicycle_3", 3.4))).parts_fit is None
+
+
+# --- the anchoring core, frame by frame --------------------------------------------------------
+
+WHOLE = SceneObject("bicycle", "bicycle", (3.0, -5.0, 0.5), size=tuple(BICYCLE))
+
+
+def run(frames: list[list[SceneObject]]) -> tuple[Anchoring, list]:
+    """Frames of percepts (every view said whole: no test saw a part cut), a matcher that compares
+    looks (each part of the bicycle has its own), as the learned one does."""
+    maker = PerceptMaker(seed=5)
+    lifecycle = LifecycleConfig(confirm_after=2, missed_frames_to_missing=1, forget_after=600.0)
+    anchoring = Anchoring(AnchoringConfig(lifecycle=lifecycle), matcher=AppearanceRules())
+    events, stamp = [], 0.0
+    for items in frames:
+        percepts = [maker.percept(item, stamp) for item in items]
+        events.extend(anchoring.process(percepts, None, stamp, partial=[False] * len(percepts)).events)
+        stamp += FRAME
+    return anchoring, events
+
+
+def part(identity: str, y: float, x: float = 3.0) -> SceneObject:
+    return SceneObject(identity, "bicycle", (x, y, 0.5), size=tuple(PART))
+
+
+def test_a_bicycle_moved_and_seen_there_in_parts_ends_as_one_anchor_besides_the_one_it_was():
+    frames = [[WHOLE]] * 10 + [[part("front wheel", 3.4)]] * 10 + [[part("middle", 4.0)]] * 10 \
+        + [[part("rear wheel", 4.58)]] * 10
+    anchoring, events = run(frames)
+    anchors = {anchor.symbol: anchor for anchor in anchoring.anchors}
+    assert sorted(anchors) == ["bicycle_1", "bicycle_2"]  # where it stood, and where it is
+    moved = anchors["bicycle_2"]
+    assert moved.state is AnchorState.CONFIRMED and moved.parts_fit is not None
+    low, high = moved.position - moved.size / 2, moved.position + moved.size / 2
+    assert low[1] == pytest.approx(3.175, abs=0.05) and high[1] == pytest.approx(4.805, abs=0.05)
+    joined = [event for event in events
+              if event.kind is AnchorEventKind.FORGOTTEN and "parts of one bicycle" in event.details["reason"]]
+    assert [event.symbol for event in joined] == ["bicycle_3", "bicycle_4"]
+
+
+def test_two_bicycles_end_to_end_seen_in_parts_stay_two():
+    frames = [[WHOLE]] * 10 + [[part("first", 3.4)]] * 10 + [[part("second", 5.4)]] * 10
+    anchoring, _ = run(frames)
+    assert sorted(anchor.symbol for anchor in anchoring.anchors) == ["bicycle_1", "bicycle_2", "bicycle_3"]
+
+
+def test_two_parts_seen_in_one_frame_stay_two_even_after_one_is_out_of_view():
+    frames = [[WHOLE]] * 10 + [[part("first", 3.4), part("second", 4.55)]] * 10 + [[part("second", 4.55)]] * 10
+    anchoring, _ = run(frames)
+    assert sorted(anchor.symbol for anchor in anchoring.anchors) == ["bicycle_1", "bicycle_2", "bicycle_3"]
