@@ -89,14 +89,11 @@ def _hand_over_sightings(kept: Anchor, merged: Anchor, index: AnchorIndex) -> No
 
 
 def apply_decision(
-    decision: Decision | Duplicate | Return | Parts | None, index: AnchorIndex, changes: FrameChanges,
-    fusion: FusionConfig,
+    decision: Decision | Duplicate | Return | None, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig
 ) -> None:
-    """Carry out a merge, forget a duplicate, undo a jump, join parts, or report what could not be decided."""
+    """Carry out a merge, forget a duplicate, undo a jump, or report what could not be decided
+    (parts of one object are joined before these are decided: :func:`join_parts`)."""
     if decision is None:
-        return
-    if isinstance(decision, Parts):
-        join_parts(decision, index, changes, fusion)
         return
     if isinstance(decision, Return):
         anchor, newcomer = decision.anchor, decision.newcomer

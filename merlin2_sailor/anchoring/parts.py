@@ -17,8 +17,9 @@ Two parts of one object differ from two objects by evidence of space and time, n
   extent the robot has seen whole of their class (an anchor of the class with at least
   :data:`~.partial_view.EXTENT_CORROBORATING_VIEWS` whole views, as :mod:`.partial_view` asks
   before a view is called a part), with a share ``slack`` more for the noise of boxes (a part's
-  box, centred on what the depth camera saw of it, reaches past the object by a few decimetres). Two whole bicycles
-  side by side, or two cats nose to tail, make a box larger than one: they are never joined.
+  box, centred on what the depth camera saw of it, reaches past the object by a few decimetres).
+  Two whole bicycles side by side, or two cats nose to tail, make a box larger than one: they are
+  never joined.
   Where the robot has not seen a whole one of the class, nothing is joined: there is no evidence
   of how large one is;
 - **one of them, at least, is a part**: its footprint is clearly less than the whole one's (under
