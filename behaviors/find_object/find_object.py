@@ -14,7 +14,8 @@ blackboard), the robot searches for it:
    be confirmed and seen since the search began; not found: the search expectation is cleared,
    so the anchor goes back to where it was last perceived). An anchor seen since the search
    began (on the way, from afar) is not announced anywhere, and the next stop is the waypoint
-   nearest where it was seen, once: the search ends there, not wherever the robot happened to be.
+   nearest where it was seen, once, reached facing where it was seen (as the stop where it was
+   last anchored is): the search ends there, not wherever the robot happened to be.
 3. On success the robot stays at that stop, and the behaviour writes ``robot_at(<stop>)``
    (DECLARED) in the knowledge base itself: the dispatcher only knows ``origin``. The anchored
    facts (``object_at``, ``missing``) are perception's to update.
@@ -142,19 +143,27 @@ def next_stop(state: BehaviorState, blackboard: Blackboard) -> str:
     search: Search = blackboard[SEARCH_KEY]
     if search.indistinguishable_from:
         return EXHAUSTED
-    stop = seen_at(state.context, search)  # seen on the way: go where it is, not to the next stop
+    sighting = reacquired(state.context, search)
+    stop = sighting_waypoint(state.context, search, sighting)  # seen on the way: go where it is
+    look_at = None
     if stop is not None:
         search.sighted.append(stop)
+        look_at = sighting
     else:
         if search.next_stop >= len(search.stops):
             return EXHAUSTED
         stop = search.stops[search.next_stop]
         search.next_stop += 1
+        if stop == search.last_place:
+            look_at = search.last_seen
     target = place_target(state.context, stop)
     place = state.context.places.get(stop)
-    if stop == search.last_place and search.last_seen is not None and place.yaw is None:
-        # Arrive facing where the object was last seen: it is the first thing the camera sees.
-        facing = target.pose.facing(search.last_seen.position[0], search.last_seen.position[1])
+    if look_at is not None and place.yaw is None:
+        # Arrive facing where the object was last seen: it is the first thing the camera sees. A
+        # waypoint driven to because it was seen from afar needs it most: the bicycle wheeled beside
+        # the living room's waypoint, seen from the kitchen, was behind the robot on arrival, not seen
+        # there, and the search gave up (scenario suite, `large_object_wheeled_away`, 6 December 2026).
+        facing = target.pose.facing(look_at.position[0], look_at.position[1])
         target = Target(stop, Pose2D(target.pose.x, target.pose.y, facing.yaw))
     blackboard[STOP_KEY] = stop
     blackboard[TARGET_KEY] = target

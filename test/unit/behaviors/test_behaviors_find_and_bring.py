@@ -214,16 +214,18 @@ def test_find_that_sees_the_object_on_the_way_goes_to_it_and_moves_no_anchor(rob
     and drives to c, where it ends; never "found at" a stop it was not at (test_mission_end_to_end,
     network, 5 December 2026: the red mug, re-found in the bedroom as the robot reached the hall,
     was announced and reported at the hall)."""
-    robot.world["cup_1"] = (5.1, 0.0)
+    robot.world["cup_1"] = (5.1, 0.5)
 
     def seen_from_afar(pose: Pose2D) -> None:
         if (pose.x, pose.y) == WAYPOINTS["b"]:
-            robot.anchoring.see("cup_1", (5.1, 0.0, 0.8))
+            robot.anchoring.see("cup_1", (5.1, 0.5, 0.8))
 
     robot.navigation.on_arrival.insert(0, seen_from_afar)
     outcome, blackboard = find(robot, "cup_1", "a")
     assert outcome == SUCCEED, blackboard
     assert stops(robot) == ["b", "c"]
     assert blackboard[FOUND_AT_KEY] == "c" and robot_locations(robot.store) == ("c",)
+    to_c = next(goal for goal in robot.navigation.goals if (goal.x, goal.y) == WAYPOINTS["c"])
+    assert to_c.yaw == pytest.approx(math.atan2(0.5 - WAYPOINTS["c"][1], 5.1 - WAYPOINTS["c"][0]))  # facing it
     assert [e.kind for e in robot.anchoring.expectations] == []  # it was seen: nothing announced
-    assert robot.anchoring.anchors["cup_1"].position[:2] == (5.1, 0.0)
+    assert robot.anchoring.anchors["cup_1"].position[:2] == (5.1, 0.5)
