@@ -50,10 +50,9 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     within that, and it is never the extent that joins are judged by, so joins cannot widen the
     class's known extent step by step."""
     kept, part = decision.kept, decision.part
-    whole = next((anchor for anchor in (kept, part)
-                  if not is_part(anchor, decision.known) and anchor.parts_fit is None), None)
+    whole = next((anchor for anchor in (kept, part) if not is_part(anchor, decision.known)), None)
     for anchor in (kept, part):
-        if is_part(anchor, decision.known):  # its views are of a part, not of the object (see parts)
+        if anchor is not whole:  # its views are of parts, not of the object (see parts)
             anchor.gallery = anchor.gallery_scales = None
     box = (whole.position.copy(), whole.size.copy(), whole.whole_views, whole.parts_fit) if whole is not None else (
         (decision.low + decision.high) / 2.0, decision.high - decision.low, EXTENT_CORROBORATING_VIEWS, decision.fit)

@@ -24,7 +24,8 @@ Two parts of one object differ from two objects by evidence of space and time, n
   of how large one is;
 - **one of them, at least, is a part**: its footprint is clearly less than the whole one's (under
   :data:`~.partial_view.PARTIAL_FOOTPRINT_SHARE` of it, as :mod:`.partial_view` tells a partial
-  view). Two anchors of whole views are the matching function's to tell apart, not this rule's;
+  view), or its box was joined from parts before. Two anchors of whole views are the matching
+  function's to tell apart, not this rule's;
 - **they were never seen at one time**: two anchors seen in one frame are two percepts, two
   objects (every anchor keeps the symbols of anchors of its class seen in a frame with it,
   ``Anchor.seen_with``);
@@ -33,7 +34,7 @@ Two parts of one object differ from two objects by evidence of space and time, n
 
 The older symbol stays, as in every merge, and its box becomes the box around both: the object's
 extent as far as the parts show it, which later views of parts beyond it widen, within the whole
-one's extent (``Anchor.parts_fit``). The appearance views of a part are dropped: the partial-view
+one's extent (``Anchor.parts_fit``). The appearance views of a part (of all but a whole one) are dropped: the partial-view
 tests let a part's views into its gallery when nothing showed them cut (the bicycle's far end,
 0.46 m of 1.6, seen whole five times), and a gallery of parts is evidence against the object
 itself: in the run above, the joined anchor's part views scored under the threshold against
@@ -146,9 +147,10 @@ def decide_parts(seen: Sequence[Anchor], index: AnchorIndex, slack: float,
 
 
 def is_part(anchor: Anchor, known: np.ndarray) -> bool:
-    """Whether the anchor's footprint is clearly less than the whole one's ``known`` extent (as
-    :mod:`.partial_view` tells a part)."""
-    return turned_extent(anchor.size)[0] < PARTIAL_FOOTPRINT_SHARE * known[0]
+    """Whether the anchor stands for a part of an object: its footprint clearly less than the whole
+    one's ``known`` extent (as :mod:`.partial_view` tells a part), or its box joined from parts (it
+    is as much of the object as its parts showed, and its views are theirs)."""
+    return anchor.parts_fit is not None or turned_extent(anchor.size)[0] < PARTIAL_FOOTPRINT_SHARE * known[0]
 
 
 def _trusted(anchor: Anchor) -> bool:

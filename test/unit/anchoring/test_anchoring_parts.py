@@ -18,8 +18,11 @@ from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
 from merlin2_sailor.anchoring.expectation import Expectation
+from merlin2_sailor.anchoring.frame_changes import FrameChanges
+from merlin2_sailor.anchoring.gallery import add_view
 from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
+from merlin2_sailor.anchoring.merge import join_parts
 from merlin2_sailor.anchoring.parts import Parts, decide_parts, largest_seen_whole
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
 from merlin2_sailor.errors import ConfigurationError
@@ -37,7 +40,8 @@ def bicycle(symbol: str, y: float, size: np.ndarray = PART, first_seen: float = 
             state: AnchorState = AnchorState.CONFIRMED, whole_views: int = 0, hue: int | None = None) -> Anchor:
     position = np.array((x, y, 0.5))
     anchor = Anchor(symbol, "bicycle", position, np.asarray(size, dtype=np.float64).copy(), first_seen,
-                    first_seen + 1.0, state=state, whole_views=whole_views, perceived_position=position.copy())
+                    first_seen + 1.0, state=state, whole_views=whole_views, perceived_position=position.copy(),
+                    class_votes={"bicycle": 3.0})
     anchor.visible = state is AnchorState.CONFIRMED
     if hue is not None:
         anchor.colour = ColourModel.of(mug_colour(hue, share=0.6))
@@ -74,6 +78,33 @@ def test_a_part_beside_a_whole_view_of_the_same_size_is_joined_and_the_whole_box
     part = bicycle("bicycle_3", 4.5, first_seen=20.0)
     [parts] = decide(whole, part)
     assert (parts.kept, parts.part) == (whole, part)
+
+
+def test_a_box_joined_from_parts_takes_a_larger_piece_and_keeps_only_the_larger_pieces_views():
+    """A box already joined from parts counts as a part (its views are the parts'), so a larger
+    piece seen later, itself too large to be called a part, joins it: the box and the appearance
+    views are the larger piece's; the joined box's views, of parts, are dropped."""
+    def with_views(anchor: Anchor, count: int) -> Anchor:
+        for view in np.random.default_rng(count).normal(size=(count, 8)):
+            anchor.gallery, anchor.gallery_scales = add_view(anchor.gallery, anchor.gallery_scales,
+                                                             view.astype(np.float32), 40.0, 10)
+        return anchor
+
+    joined = with_views(bicycle("bicycle_2", 4.20, np.array((0.35, 1.0, 1.0)), first_seen=10.0, whole_views=2), 3)
+    joined.parts_fit = BICYCLE[[1, 0, 2]] * (1.0 + SLACK)
+    larger = with_views(bicycle("bicycle_3", 4.45, np.array((0.35, 1.1, 1.0)), first_seen=20.0, whole_views=3), 2)
+    larger_views = larger.gallery.copy()
+    [parts] = decide(seen_whole_elsewhere(), joined, larger)
+    assert (parts.kept, parts.part) == (joined, larger)
+    index = AnchorIndex()
+    for anchor in (joined, larger):
+        index.add(anchor)
+    join_parts(parts, index, FrameChanges(30.0), AnchoringConfig().fusion)
+    assert "bicycle_3" not in index and joined.state is AnchorState.CONFIRMED
+    np.testing.assert_array_equal(joined.gallery, larger_views)
+    low, high = joined.position - joined.size / 2, joined.position + joined.size / 2
+    assert (low[1], high[1]) == pytest.approx((3.90, 5.00))
+    assert joined.parts_fit is None and joined.whole_views == 3  # the larger piece's, seen whole
 
 
 @pytest.mark.parametrize(
