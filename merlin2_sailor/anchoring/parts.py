@@ -34,12 +34,12 @@ Two parts of one object differ from two objects by evidence of space and time, n
 
 The older symbol stays, as in every merge, and its box becomes the box around both: the object's
 extent as far as the parts show it, which later views of parts beyond it widen, within the whole
-one's extent (``Anchor.parts_fit``). The appearance views of a part (of all but a whole one) are dropped: the partial-view
-tests let a part's views into its gallery when nothing showed them cut (the bicycle's far end,
-0.46 m of 1.6, seen whole five times), and a gallery of parts is evidence against the object
-itself: in the run above, the joined anchor's part views scored under the threshold against
-the bicycle's whole views, so a search did not take it. Without them the object is compared by
-class, place and time until whole views come.
+one's extent (``Anchor.parts_fit``). The appearance views of a part (of all but a whole one) are
+dropped: the partial-view tests let a part's views into its gallery when nothing showed them cut
+(the bicycle's far end, 0.46 m of 1.6, seen whole five times), and a gallery of parts is evidence
+against the object itself: in the run above, the joined anchor's part views scored under the
+threshold against the bicycle's whole views, so a search did not take it. Without them the
+object is compared by class, place and time until whole views come.
 """
 
 from __future__ import annotations

@@ -347,6 +347,10 @@ SETTINGS: tuple[Setting, ...] = (
                 "centred there is usually cut off and missed).", 0.0, 1000.0),
         Setting("occlusion_margin", ("core", "visibility", "occlusion_margin"),
                 "How much nearer (m) than an anchor's front a depth reading must be to hide it.", 0.0, 10.0),
+        Setting("visible_in_image_share", ("core", "visibility", "in_image_share"),
+                "Share of an anchor's projected 3D box that must be inside the image for it to be expected "
+                "in view (a large object close by, its centre in the image but mostly outside it, is not "
+                "detected; 0 turns it off).", 0.0, 1.0),
     ),
     *_group(
         "Identity: expectations, searches and reappearances",

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import CameraView, VisibilityConfig
-from merlin2_sailor.anchoring.visibility import should_be_visible
+from merlin2_sailor.anchoring.visibility import in_image_shares, should_be_visible
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
 
 from .anchoring_scenes import TEST_INTRINSICS, camera_view, flat_depth, looking_along_x, with_occluder
@@ -58,3 +58,21 @@ def test_visibility_configuration_is_validated():
 
 def test_empty_input():
     assert should_be_visible(np.zeros((0, 3)), np.zeros((0, 3)), camera_view(), VisibilityConfig()).shape == (0,)
+
+
+def test_a_large_object_close_by_is_not_expected_when_most_of_it_is_outside_the_image():
+    """Its centre is in the image, but a detector sees what of it is in the picture: a bicycle
+    0.6 m ahead spans twice the image's width; the same bicycle 3 m ahead, or a mug 0.6 m ahead,
+    fits. A box reaching behind the camera is not in view at all."""
+    view = camera_view()
+    bicycle, mug = np.array([[0.35, 1.6, 1.0]]), np.array([[0.1, 0.1, 0.12]])
+    config = VisibilityConfig()
+    assert not should_be_visible(np.array([[0.6, 0.0, 0.8]]), bicycle, view, config)[0]
+    assert should_be_visible(np.array([[3.0, 0.0, 0.8]]), bicycle, view, config)[0]
+    assert should_be_visible(np.array([[0.6, 0.0, 0.9]]), mug, view, config)[0]
+    assert not should_be_visible(np.array([[0.3, 0.0, 0.8]]), np.array([[1.0, 1.0, 1.0]]), view, config)[0]
+    off = VisibilityConfig(in_image_share=0.0)  # only the centre, as before the share was asked
+    assert should_be_visible(np.array([[0.6, 0.0, 0.8]]), bicycle, view, off)[0]
+    np.testing.assert_allclose(in_image_shares(np.array([[3.0, 0.0, 1.0]]), mug, view), [1.0])
+    with pytest.raises(ConfigurationError, match="in_image_share"):
+        VisibilityConfig(in_image_share=1.5)
