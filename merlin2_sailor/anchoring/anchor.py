@@ -220,18 +220,11 @@ class Anchor:
         centred on the part in view: once the anchor has had a whole view, a partial one keeps it
         alive but moves and resizes it no more; before that, it is the best there is, but weighs
         ``partial_view_variance_factor`` times less. Its crop never joins the appearance gallery.
-        Where the anchor stands by an expectation (a search moved it to the middle of the searched
-        disc), the view, even a partial one, puts it where it was seen: perception outranks
-        expectation, and a bicycle found by a search through a door frame stayed 2.1 m off, in the
-        middle of the kitchen (scenario suite, `large_object_wheeled_away`, 6 December 2026).
         """
         self.times_seen += 1
         if partial and self.parts_fit is not None:
             self._widen_to(percept)
-        if self.provenance is Provenance.EXPECTED:
-            self.position = np.asarray(percept.position, dtype=np.float64).copy()
-            self.position_variance = config.initial_variance * (config.partial_view_variance_factor if partial else 1.0)
-        elif not partial or self.whole_views == 0:
+        if not partial or self.whole_views == 0:
             self.position, self.position_variance = fuse_position(
                 self.position, self.position_variance, percept.position, percept.stamp - self.last_seen, config,
                 partial,

@@ -88,6 +88,13 @@ def resolve_expectation(anchor: Anchor, percept: Percept, changes: FrameChanges,
         return
     if not anchor.expectation_confirmed:
         changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="expectation", **details)
+    if expectation.is_search and np.allclose(anchor.position, expectation.position):
+        # Found by a search: where it was seen, not the middle of the searched disc, which partial
+        # views (a bicycle seen through a door frame) do not move it from. Left there, the bicycle
+        # found from the kitchen was placed 2.1 m off, in the kitchen (scenario suite,
+        # `large_object_wheeled_away`, network, 6 December 2026).
+        anchor.position = np.asarray(percept.position, dtype=np.float64).copy()
+        anchor.perceived_position = anchor.position.copy()
     if expectation.kind is ExpectationKind.CARRIED:
         anchor.expectation_confirmed = True  # still carried: keep following the robot
     else:

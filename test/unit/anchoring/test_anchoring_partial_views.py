@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, AnchorState
+from merlin2_sailor.anchoring import Anchoring, AnchoringConfig, AnchorState, Expectation
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_comparison import identity_scores
 from merlin2_sailor.anchoring.features import extent_slack
@@ -22,7 +22,6 @@ from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
 from merlin2_sailor.contract.percept import BoundingBox2D
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError
-from merlin2_sailor.knowledge.model import Provenance
 
 from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, camera_view, flat_depth
 
@@ -273,19 +272,26 @@ def test_one_box_around_two_neighbours_does_not_make_their_views_its_parts(maker
         mug_anchor.symbol]
 
 
-def test_a_partial_view_moves_an_anchor_that_stands_where_an_expectation_put_it(maker) -> None:
-    """Perception outranks expectation: a search put the anchor in the middle of its disc, and the
-    first view of the object there is of a part; it must move the anchor, though a partial view of
-    an anchor seen whole would not."""
-    config = AnchoringConfig().fusion
-    anchor = Anchor.from_percept("bicycle_1", view_of(maker, BICYCLE, 0.0, MIDDLE_BOX), None, config)
-    anchor.whole_views = 5
-    part = view_of(maker, BICYCLE, 1.0, EDGE_BOX, centre=(3.0, 2.5, 0.5), size=(0.35, 0.5, 1.0))
-    anchor.absorb(part, None, config, partial=True)
-    assert np.linalg.norm(anchor.position[:2] - np.array((3.0, 0.0))) < 0.05  # perceived: a part does not move it
-
-    anchor.position = np.array((5.0, 5.0, 0.5))  # where a search's disc is centred
-    anchor.position_variance = 1.0
-    anchor.provenance = Provenance.EXPECTED
-    anchor.absorb(part, None, config, partial=True)
-    assert np.linalg.norm(anchor.position[:2] - np.array((3.0, 2.5))) < 0.05
+def test_a_search_confirmed_by_a_partial_view_puts_the_anchor_where_it_was_seen(maker) -> None:
+    """Perception outranks expectation: a search put the missing bicycle's anchor in the middle of
+    the searched disc, and the views that find it there are of a part (through a door frame). A
+    partial view does not move an anchor seen whole, but the disc's middle is no place the object
+    was seen: once the search is confirmed, the anchor is where the view saw it."""
+    anchoring = Anchoring()
+    camera = camera_view()
+    for frame in range(4):
+        anchoring.process([view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX)], camera, frame * 0.1,
+                          partial=[False])
+    bicycle = anchoring.get("bicycle_1")
+    bicycle.state, bicycle.missing_since, bicycle.lost_after = AnchorState.MISSING, 1.0, 0.3
+    anchoring.expect("bicycle_1", Expectation.at(np.array((3.0, 2.0, 0.5)), 5.0, "hall", "find_object", 1.5))
+    assert bicycle.position[:2] == pytest.approx((3.0, 2.0))
+    part_seen = (3.0, 2.6, 0.5)
+    for frame in range(12):
+        stamp = 6.0 + frame * 0.1
+        anchoring.process([view_of(maker, BICYCLE, stamp, EDGE_BOX, centre=part_seen, size=(0.35, 0.5, 1.0))],
+                          None, stamp, partial=[True])
+        if bicycle.state is AnchorState.CONFIRMED:
+            break
+    assert bicycle.state is AnchorState.CONFIRMED and bicycle.expectation is None
+    assert np.linalg.norm(bicycle.position[:2] - np.array(part_seen[:2])) < 0.05
