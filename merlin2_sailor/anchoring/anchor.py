@@ -294,22 +294,6 @@ class Anchor:
         self.visible = other.visible
         self.provenance = Provenance.PERCEIVED
 
-    def disown_colourless_sightings(self) -> None:
-        """A whole view of another colour disputed this anchor in its place: its sightings since its
-        last view of its own colour (far or cut-off views, without a colour) may have been of the
-        object that stands there now, so its last sighting is that last coloured one. Left as they
-        were, the red mug's anchor, replaced by a green mug while the robot was away, kept a far view
-        of the green mug as its last sighting, and the report of what it last saw named the green
-        mug (scenario suite, `replaced_by_another_colour`, network, seeds 1 and 2, 5 December 2026)."""
-        if self.colour_seen is None or self.colour_seen >= self.last_seen:
-            return
-        self.last_seen = self.colour_seen
-        if self.lost_after is not None:
-            self.lost_after = min(self.lost_after, self.colour_seen)
-        kept = [stamp for stamp in self.recent_sightings if stamp <= self.colour_seen]
-        self.recent_sightings.clear()
-        self.recent_sightings.extend(kept)
-
     def colour_unchecked(self, stamp: float, config: ColourEvidenceConfig) -> bool:
         """Whether its colour has gone unchecked for ``config.absence`` at ``stamp`` (no whole view
         with a colour fused since), or a view of another colour disputed it: whether a view's

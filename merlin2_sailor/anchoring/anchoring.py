@@ -227,8 +227,6 @@ class Anchoring:
         table = self._table_builder.build(percepts, self._index, whole)
         for anchor in table.disputed:
             anchor.colour_disputed = True
-            anchor.disown_colourless_sightings()
-            self._index.refresh(anchor)
         for anchor in table.suspected:
             if self.config.colour.suspicion_stale(anchor.colour_suspected, stamp):
                 anchor.colour_suspected = stamp

@@ -314,27 +314,6 @@ def test_views_without_colour_do_not_bring_back_an_anchor_a_view_of_another_colo
     assert not anchoring.get("cup_1").colour_disputed
 
 
-def test_a_disputed_anchor_was_last_seen_at_its_last_view_of_its_own_colour() -> None:
-    """The far views without colour that reacquired the red mug's anchor were of the green mug put
-    in its place: once a view of another colour disputes the anchor, its last sighting goes back
-    to its last coloured one, the last that was surely its object (and a report of what it last
-    saw names the red mug, not the green one)."""
-    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
-    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
-    green_far = SceneObject("green", "cup", KITCHEN)
-    anchoring, maker = rules(), PerceptMaker(seed=6)
-    see(anchoring, maker, [red], 0.0)
-    cup = anchoring.get("cup_1")
-    own_colour = cup.colour_seen
-    assert own_colour is not None and own_colour < 1.0
-    see(anchoring, maker, [green_far], 60.0, frames=2)
-    assert cup.last_seen >= 60.0  # not yet known to be another mug's sightings
-    see(anchoring, maker, [green], 61.0, frames=SUSPICION_FRAMES)
-    assert cup.colour_disputed and cup.last_seen == own_colour
-    assert cup.lost_after is None or cup.lost_after <= own_colour
-    assert all(stamp <= own_colour for stamp in cup.recent_sightings)
-
-
 def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
     red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
     green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
