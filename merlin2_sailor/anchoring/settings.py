@@ -330,8 +330,9 @@ SETTINGS: tuple[Setting, ...] = (
                 "Seconds a never-confirmed anchor (often a false detection) survives not being seen where "
                 "it should have been.", 0.0, 3600.0),
         Setting("confirm_within", ("core", "lifecycle", "confirm_within"),
-                "Seconds within which a never-confirmed anchor's sightings must follow one another to add "
-                "up to a confirmation (sparse sightings at one spot are a detector's false positives).",
+                "Seconds within which a never-confirmed anchor's sightings, or a missing one's, must follow "
+                "one another to add up to a confirmation (sparse sightings at one spot are a detector's "
+                "false positives).",
                 0.0, 3600.0),
     ),
     *_group(

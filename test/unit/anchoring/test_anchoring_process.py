@@ -133,6 +133,29 @@ def test_sightings_of_a_tentative_anchor_far_apart_do_not_confirm_it(make_anchor
     assert anchoring.get("cup_1").first_seen == 24.0
 
 
+def test_sightings_of_a_missing_anchor_far_apart_do_not_bring_it_back(make_anchoring, quick_lifecycle, maker,
+                                                                      kitchen):
+    """The same for a lost object's way back: single views at its spot, further apart in time than
+    ``confirm_within`` and never unseen in between (the camera turns away after each), are not it
+    coming back; two a frame apart are."""
+    lifecycle = dataclasses.replace(quick_lifecycle, confirm_within=1.0)
+    anchoring = make_anchoring(AnchoringConfig(lifecycle=lifecycle))  # confirm_after = 2
+    cup = kitchen["red_cup"]
+    for frame in range(3):
+        anchoring.process([maker.percept(cup, frame * FRAME)], camera_view(), frame * FRAME)
+    for frame in range(3, 8):  # looked at, not there: missing
+        anchoring.process([], camera_view(), frame * FRAME)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    turned_away = camera_view(yaw=math.pi)
+    for stamp in (1.0, 2.5, 4.0):
+        result = anchoring.process([maker.percept(cup, stamp)], camera_view(), stamp)
+        assert result.percept_symbols == ("cup_1",) and AnchorEventKind.CONFIRMED not in kinds(result)
+        anchoring.process([], turned_away, stamp + 0.5)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    result = anchoring.process([maker.percept(cup, 4.0 + FRAME)], camera_view(), 4.0 + FRAME)
+    assert AnchorEventKind.CONFIRMED in kinds(result) and anchoring.get("cup_1").state is AnchorState.CONFIRMED
+
+
 def test_occluded_object_is_not_marked_missing(make_anchoring, maker, kitchen):
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
