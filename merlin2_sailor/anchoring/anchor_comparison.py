@@ -71,9 +71,13 @@ def identity_scores(
     # is compared without its look, as a partial percept is (matching_table.comparable_views);
     # so is a lost anchor that knew only a part of what the candidate shows whole (a bicycle's
     # end anchored first, the whole bicycle later: scenario suite, 4 December, a duplicate).
+    # So is a candidate whose box was joined from parts (:mod:`.parts`): its views are its parts',
+    # the whole object's look it never saw (the joined bicycle of `large_object_wheeled_away` was
+    # never taken by the search for the bicycle it was: scenario suite, network, 6 December 2026).
     sizes = np.array([anchor.size for anchor in candidates])
     comparable = (comparable_views(sizes, None, [lost])[:, 0]
-                  & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0])
+                  & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0]
+                  & np.array([anchor.parts_fit is None for anchor in candidates]))
     percepts, owners, scales = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
     anchors = AnchorColumns.from_anchors([lost])
     if lost.lost_after is not None:

@@ -15,6 +15,7 @@ import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState
 from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
 from merlin2_sailor.anchoring.expectation import Expectation
@@ -237,3 +238,22 @@ def test_two_parts_seen_in_one_frame_stay_two_even_after_one_is_out_of_view():
     frames = [[WHOLE]] * 10 + [[part("first", 3.4), part("second", 4.55)]] * 10 + [[part("second", 4.55)]] * 10
     anchoring, _ = run(frames)
     assert sorted(anchor.symbol for anchor in anchoring.anchors) == ["bicycle_1", "bicycle_2", "bicycle_3"]
+
+
+def test_a_box_joined_from_parts_is_compared_with_a_lost_anchor_without_its_look():
+    """Its views are of its parts: a matcher that reads looks must not hold them against the whole
+    object's (a search for the bicycle never took the anchor its parts made)."""
+    def with_view(anchor: Anchor, seed: int) -> Anchor:
+        view = np.abs(np.random.default_rng(seed).normal(size=32)).astype(np.float32)
+        anchor.gallery, anchor.gallery_scales = add_view(None, None, view / np.linalg.norm(view), 40.0, 10)
+        return anchor
+
+    lost = with_view(bicycle("bicycle_1", 4.0, BICYCLE, first_seen=0.0, state=AnchorState.MISSING,
+                             whole_views=20), 1)
+    lost.lost_after = 1.0
+    candidate = with_view(bicycle("bicycle_2", 4.1, BICYCLE, first_seen=30.0, whole_views=2), 2)
+    matcher = AppearanceRules()
+    by_look = score_anywhere(matcher, candidate, lost)
+    candidate.parts_fit = BICYCLE[[1, 0, 2]] * (1.0 + SLACK)
+    without_look = score_anywhere(matcher, candidate, lost)
+    assert by_look < 0.5 <= without_look
