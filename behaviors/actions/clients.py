@@ -71,7 +71,8 @@ class AnchorReport:
     state: AnchorState
     position: Point
     last_seen: float
-    """When it was last perceived, in the anchoring node's clock (seconds)."""
+    """When it was last perceived, in the anchoring node's clock (seconds): its latest sighting
+    nothing since has put in doubt (the ``Anchor`` message's ``last_seen``)."""
     times_seen: int = 0
     indistinguishable_from: tuple[str, ...] = ()
     """While missing: anchors a search found that the anchoring layer cannot tell from this one

@@ -125,6 +125,10 @@ class Anchor:
     colour_disputed: bool = False
     """A whole view of another colour stood where this anchor was expected: until a view of its own
     colour is fused, views that show no colour cannot be it either."""
+    doubted_sightings: tuple[float, float] | None = None
+    """Set when a view of another colour disputed it (:meth:`dispute_colour`): its sightings after
+    the first stamp up to the second, all without a colour, may have been of the object that
+    disputed it; None when none are in doubt. See :attr:`last_sure_sighting`."""
     colour_suspected: float | None = None
     """When a first whole view of another colour stood where it was expected (None: no such view
     since its colour was last seen): a second one soon after rules the anchor out. Not kept in
@@ -172,6 +176,33 @@ class Anchor:
     it has not jumped lately. Not persisted: it matters for a few seconds."""
     left_at: float = 0.0
     """When it left ``left_place``."""
+
+    @property
+    def last_sure_sighting(self) -> float:
+        """The stamp of its latest sighting that nothing since has put in doubt: what it reports as
+        last seen. Views without a colour fused after its last view of its own colour, and before a
+        view of another colour disputed it in its place, may have been of that other object: the red
+        mug's anchor, replaced by a green mug while the robot was away, took far views of the green
+        mug before a close one told the colours apart, and reported the green mug's sighting as its
+        own (scenario suite, `replaced_by_another_colour`, network, 5-6 December 2026). Sightings
+        taken after the dispute, knowing of it, count again; so does a view of its own colour."""
+        doubted = self.doubted_sightings
+        if doubted is None or self.last_seen > doubted[1]:
+            return self.last_seen
+        return doubted[0]
+
+    def dispute_colour(self) -> None:
+        """A whole view of another colour stood in its place: until a view of its own colour, its
+        colourless sightings since its colour was last seen are in doubt (:attr:`last_sure_sighting`).
+        Its other records (last sighting, recent sightings) stay: they say when it was matched,
+        which rules such as :mod:`.same_space` read as "stood together"; taking them back left a
+        duplicate book those rules would have merged (`moved_to_another_rooms_floor`, network,
+        seed 0, 6 December 2026)."""
+        self.colour_disputed = True
+        if self.colour_seen is not None and self.colour_seen < self.last_seen:
+            start = self.colour_seen if self.doubted_sightings is None else min(self.doubted_sightings[0],
+                                                                                 self.colour_seen)
+            self.doubted_sightings = (start, self.last_seen)
 
     @property
     def confidence(self) -> float:
@@ -239,6 +270,7 @@ class Anchor:
                 self.colour_seen = percept.stamp
                 self.colour_disputed = False
                 self.colour_suspected = None
+                self.doubted_sightings = None
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
         if embedding is not None and not partial:  # a part's look is not the object's (matching_table)

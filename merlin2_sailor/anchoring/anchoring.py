@@ -226,7 +226,7 @@ class Anchoring:
         percepts = shift_percepts(percepts, frame_offset)
         table = self._table_builder.build(percepts, self._index, whole)
         for anchor in table.disputed:
-            anchor.colour_disputed = True
+            anchor.dispute_colour()
         for anchor in table.suspected:
             if self.config.colour.suspicion_stale(anchor.colour_suspected, stamp):
                 anchor.colour_suspected = stamp

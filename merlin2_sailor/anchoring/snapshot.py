@@ -66,6 +66,7 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
             for key, model in anchor.colour_by_size.ordered()},
         "colour_seen": anchor.colour_seen,
         "colour_disputed": bool(anchor.colour_disputed),
+        "doubted_sightings": None if anchor.doubted_sightings is None else list(anchor.doubted_sightings),
         "missed_frames": int(anchor.missed_frames),
         "recovery_sightings": int(anchor.recovery_sightings),
         "missing_since": anchor.missing_since,
@@ -80,6 +81,14 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "seen_with": sorted(anchor.seen_with),
         "parts_fit": None if anchor.parts_fit is None else anchor.parts_fit.tolist(),
     }
+
+
+def _doubted(value: Any) -> tuple[float, float] | None:
+    """The doubted sightings' window, from a snapshot (None where an older one has none)."""
+    if value is None:
+        return None
+    start, end = (float(stamp) for stamp in value)
+    return start, end
 
 
 def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
@@ -107,6 +116,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             colour_seen=None if data.get("colour_seen") is None or "colour_by_size" not in data
             else float(data["colour_seen"]),
             colour_disputed=bool(data.get("colour_disputed", False)) and "colour_by_size" in data,
+            doubted_sightings=_doubted(data.get("doubted_sightings")),
             visible=False,
             missed_frames=int(data.get("missed_frames", 0)),
             recovery_sightings=int(data.get("recovery_sightings", 0)),

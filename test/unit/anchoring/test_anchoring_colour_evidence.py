@@ -17,6 +17,8 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
+from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor_view import AnchorView
 from merlin2_sailor.anchoring.colour_evidence import (
     ColourBySize,
     ColourEvidenceConfig,
@@ -312,6 +314,50 @@ def test_views_without_colour_do_not_bring_back_an_anchor_a_view_of_another_colo
     # The red mug put back: a view of its own colour settles the dispute.
     assert see(anchoring, maker, [red], 120.0, frames=6).percept_symbols == ("cup_1",)
     assert not anchoring.get("cup_1").colour_disputed
+
+
+@pytest.mark.parametrize(("own", "other", "far_frames"), [(RED, GREEN, 2), (GREEN, BLUE, 5), (BLUE, 3, 1)])
+def test_colourless_views_before_a_dispute_are_not_reported_as_the_anchors_last_sighting(own, other, far_frames):
+    """The swap seen from afar first: the far views of the green mug went to the red mug's anchor;
+    once a close view disputes it, the anchor reports its last sighting of its own colour, not
+    those, until a view of its own colour comes back."""
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(own))
+    green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(other))
+    green_far = SceneObject("green", "cup", KITCHEN)
+    anchoring, maker = rules(), PerceptMaker(seed=own + far_frames)
+    see(anchoring, maker, [red], 0.0)
+    own_colour_seen = anchoring.get("cup_1").colour_seen
+    see(anchoring, maker, [green_far], 60.0, frames=far_frames)
+    cup_1 = anchoring.get("cup_1")
+    assert cup_1.last_seen == pytest.approx(60.0 + (far_frames - 1) * FRAME)
+    assert cup_1.last_sure_sighting == cup_1.last_seen  # nothing has disputed them yet
+    see(anchoring, maker, [green], 61.0, frames=SUSPICION_FRAMES)
+    assert cup_1.colour_disputed
+    assert cup_1.last_seen == pytest.approx(60.0 + (far_frames - 1) * FRAME)  # still when it was matched
+    assert cup_1.last_sure_sighting == own_colour_seen
+    assert AnchorView.of(cup_1).last_seen == own_colour_seen
+    restored = rules()
+    restored.restore(json.loads(json.dumps(anchoring.snapshot())))
+    assert restored.get("cup_1").last_sure_sighting == own_colour_seen
+    # The red mug put back: a view of its own colour ends the doubt.
+    see(anchoring, maker, [red], 120.0, frames=6)
+    assert not cup_1.colour_disputed and cup_1.doubted_sightings is None
+    assert cup_1.last_sure_sighting == cup_1.last_seen == pytest.approx(120.0 + 5 * FRAME)
+
+
+def test_sightings_after_a_dispute_count_again() -> None:
+    """Only the sightings before the dispute are in doubt: one taken later, by a matching that knew
+    of it, is reported; an anchor never seen in colour has nothing to fall back on and doubts none."""
+    anchor = Anchor("cup_1", "cup", np.zeros(3), np.full(3, 0.1), first_seen=0.0, last_seen=5.0, colour_seen=2.0)
+    anchor.dispute_colour()
+    assert anchor.doubted_sightings == (2.0, 5.0) and anchor.last_sure_sighting == 2.0
+    anchor.last_seen = 7.0
+    assert anchor.last_sure_sighting == 7.0
+    anchor.dispute_colour()  # disputed again: the window grows, from the same start
+    assert anchor.doubted_sightings == (2.0, 7.0) and anchor.last_sure_sighting == 2.0
+    colourless = Anchor("cup_2", "cup", np.zeros(3), np.full(3, 0.1), first_seen=0.0, last_seen=5.0)
+    colourless.dispute_colour()
+    assert colourless.colour_disputed and colourless.last_sure_sighting == 5.0
 
 
 def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
