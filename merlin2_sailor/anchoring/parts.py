@@ -123,10 +123,13 @@ def decide_parts(seen: Sequence[Anchor], index: AnchorIndex, slack: float,
         return []
     decisions: list[Parts] = []
     settled: set[str] = set()
+    known_of_class: dict[str, np.ndarray | None] = {}  # nothing changes until the decisions are applied
     for anchor in seen:
         if anchor.symbol in settled or not _trusted(anchor):
             continue
-        known = largest_seen_whole(index, anchor.class_name, slack)
+        if anchor.class_name not in known_of_class:
+            known_of_class[anchor.class_name] = largest_seen_whole(index, anchor.class_name, slack)
+        known = known_of_class[anchor.class_name]
         if known is None:
             continue
         fit = known * (1.0 + slack)
