@@ -44,7 +44,14 @@ class AnchorRecord:
 def associate(
     truth: Sequence[TrueObject], anchors: Sequence[AnchorRecord], max_distance: float = 0.5
 ) -> dict[str, str]:
-    """True object id -> anchor symbol, one to one, same class, at most ``max_distance`` apart."""
+    """True object id -> anchor symbol, one to one, same class, at most ``max_distance`` apart.
+
+    An anchor that sees its object (CONFIRMED) is preferred to a MISSING one within reach: a
+    MISSING anchor says its object is not where it stands. The red mug's MISSING anchor, left
+    where a green mug was put in its place, was 0.02 m nearer to the green mug than the green mug's
+    own anchor and took it by distance alone, and the green mug's anchor counted as a duplicate
+    (`replaced_by_another_colour`, network, seed 0, 6 December 2026). A MISSING anchor alone near
+    an object still anchors it."""
     if not truth or not anchors:
         return {}
     true_xyz = np.array([obj.position for obj in truth], dtype=float)
@@ -52,7 +59,8 @@ def associate(
     distance = np.linalg.norm(true_xyz[:, None, :] - anchor_xyz[None, :, :], axis=2)
     same_class = np.array([[obj.class_name == a.class_name for a in anchors] for obj in truth])
     allowed = same_class & (distance <= max_distance)
-    cost = np.where(allowed, distance, max_distance * 1e3)
+    missing = np.array([anchor.state == "missing" for anchor in anchors], dtype=bool)
+    cost = np.where(allowed, distance + np.where(missing, max_distance, 0.0)[None, :], max_distance * 1e3)
     rows, columns = linear_sum_assignment(cost)
     return {truth[r].id: anchors[c].symbol for r, c in zip(rows, columns, strict=True) if allowed[r, c]}
 

@@ -31,6 +31,24 @@ def test_association_is_one_to_one_same_class_and_gated():
     assert associate(TRUTH, anchors) == {"mug_a": "cup_1"}
 
 
+def test_an_anchor_that_sees_its_object_is_preferred_to_a_missing_one_nearer_to_it():
+    """A green mug put where the red one stood: the red mug's MISSING anchor is nearer to it than
+    the green mug's own anchor, yet says its object is not there; alone, a MISSING anchor still
+    anchors the object it stands by (one not seen again yet)."""
+    for offset in (0.0, 0.02, 0.2):
+        missing = AnchorRecord("cup_1", "cup", (1.0 + offset / 4, 0.0, 0.8), state="missing")
+        seeing = AnchorRecord("cup_7", "cup", (1.0 + offset, 0.0, 0.8))
+        assert associate(TRUTH, [missing, seeing])["mug_a"] == "cup_7"
+        assert associate(TRUTH, [seeing, missing])["mug_a"] == "cup_7"
+    assert associate(TRUTH, [AnchorRecord("cup_1", "cup", (1.2, 0.0, 0.8), state="missing")]) == {"mug_a": "cup_1"}
+    history = IdentityHistory()
+    history.record({"mug_a": "cup_1"})
+    replaced = [TrueObject("green_mug", "cup", (1.0, 0.0, 0.8)), *TRUTH[1:]]
+    card = score(replaced, [AnchorRecord("cup_1", "cup", (1.0, 0.0, 0.8), state="missing"),
+                            AnchorRecord("cup_7", "cup", (1.03, 0.0, 0.8))], history=history)
+    assert card.duplicates == () and card.anchored == 1
+
+
 def test_the_scorecard_counts_misses_duplicates_errors_and_facts():
     anchors = [
         AnchorRecord("cup_1", "cup", (1.1, 0.0, 0.8)),
