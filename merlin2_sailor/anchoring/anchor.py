@@ -185,7 +185,12 @@ class Anchor:
         mug's anchor, replaced by a green mug while the robot was away, took far views of the green
         mug before a close one told the colours apart, and reported the green mug's sighting as its
         own (scenario suite, `replaced_by_another_colour`, network, 5-6 December 2026). Sightings
-        taken after the dispute, knowing of it, count again; so does a view of its own colour."""
+        taken after the first dispute count again, as they did before: the matching gave them to it
+        knowing of the dispute, and an anchor still seen after one is most often its object seen
+        from a new side (the green mug, swapped into the kitchen, was disputed there again and again
+        while its anchor followed it; doubting every sighting up to the latest dispute had it report
+        a sighting from before the swap, `swapped`, seed 0, 6 December 2026). So does a view of its
+        own colour."""
         doubted = self.doubted_sightings
         if doubted is None or self.last_seen > doubted[1]:
             return self.last_seen
@@ -194,15 +199,15 @@ class Anchor:
     def dispute_colour(self) -> None:
         """A whole view of another colour stood in its place: until a view of its own colour, its
         colourless sightings since its colour was last seen are in doubt (:attr:`last_sure_sighting`).
+        Only the first dispute since its colour was seen sets the doubt (:attr:`last_sure_sighting`).
         Its other records (last sighting, recent sightings) stay: they say when it was matched,
         which rules such as :mod:`.same_space` read as "stood together"; taking them back left a
         duplicate book those rules would have merged (`moved_to_another_rooms_floor`, network,
         seed 0, 6 December 2026)."""
+        first = not self.colour_disputed
         self.colour_disputed = True
-        if self.colour_seen is not None and self.colour_seen < self.last_seen:
-            start = self.colour_seen if self.doubted_sightings is None else min(self.doubted_sightings[0],
-                                                                                 self.colour_seen)
-            self.doubted_sightings = (start, self.last_seen)
+        if first and self.colour_seen is not None and self.colour_seen < self.last_seen:
+            self.doubted_sightings = (self.colour_seen, self.last_seen)
 
     @property
     def confidence(self) -> float:

@@ -353,8 +353,8 @@ def test_sightings_after_a_dispute_count_again() -> None:
     assert anchor.doubted_sightings == (2.0, 5.0) and anchor.last_sure_sighting == 2.0
     anchor.last_seen = 7.0
     assert anchor.last_sure_sighting == 7.0
-    anchor.dispute_colour()  # disputed again: the window grows, from the same start
-    assert anchor.doubted_sightings == (2.0, 7.0) and anchor.last_sure_sighting == 2.0
+    anchor.dispute_colour()  # disputed again while still seen: what it was given since stays its own
+    assert anchor.doubted_sightings == (2.0, 5.0) and anchor.last_sure_sighting == 7.0
     colourless = Anchor("cup_2", "cup", np.zeros(3), np.full(3, 0.1), first_seen=0.0, last_seen=5.0)
     colourless.dispute_colour()
     assert colourless.colour_disputed and colourless.last_sure_sighting == 5.0
