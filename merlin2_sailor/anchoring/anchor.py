@@ -325,6 +325,16 @@ class Anchor:
         self.seen_with = (self.seen_with | other.seen_with) - {self.symbol, other.symbol}
         self.colour = combined(self.colour, other.colour)
         self.colour_by_size = combined_by_size(self.colour_by_size, other.colour_by_size)
+        if other.colour_seen is not None and (self.colour_seen is None or other.colour_seen > self.colour_seen):
+            # Its colour was last checked by ``other``'s views, fused now: a dispute before them was
+            # answered by a view of its own colour. Left as they were, the green mug's anchor, merged
+            # with the anchor of the same mug moved into the kitchen, counted its colour unchecked since
+            # the living room and doubted every kitchen sighting before a later dispute (`swapped`,
+            # network, seed 0, 6 December 2026).
+            self.colour_seen = other.colour_seen
+            self.colour_disputed = other.colour_disputed
+            self.colour_suspected = other.colour_suspected
+            self.doubted_sightings = other.doubted_sightings
         self.times_seen += other.times_seen
         self.last_seen = max(self.last_seen, other.last_seen)
         self.last_tracker_id = other.last_tracker_id or self.last_tracker_id

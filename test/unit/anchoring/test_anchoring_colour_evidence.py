@@ -360,6 +360,27 @@ def test_sightings_after_a_dispute_count_again() -> None:
     assert colourless.colour_disputed and colourless.last_sure_sighting == 5.0
 
 
+def mug_anchor(symbol: str, first_seen: float, last_seen: float, colour_seen: float) -> Anchor:
+    return Anchor(symbol, "cup", np.zeros(3), np.full(3, 0.1), first_seen=first_seen, last_seen=last_seen,
+                  colour_seen=colour_seen, class_votes={"cup": 1.0})
+
+
+def test_a_merge_carries_the_latest_colour_check_and_what_it_settled() -> None:
+    """A mug found moved: its old anchor, disputed where it stood, takes the newer anchor's views of
+    its own colour, so its colour was checked then, the dispute is answered and nothing is in doubt;
+    an older view merged in changes none of that."""
+    fusion = AnchoringConfig().fusion
+    disputed = mug_anchor("cup_1", 0.0, 5.0, colour_seen=2.0)
+    disputed.dispute_colour()
+    disputed.absorb_anchor(mug_anchor("cup_2", 30.0, 31.0, colour_seen=31.0), fusion)
+    assert disputed.colour_seen == 31.0 and not disputed.colour_disputed and disputed.doubted_sightings is None
+    assert disputed.last_sure_sighting == 31.0
+    kept = mug_anchor("cup_4", 0.0, 5.0, colour_seen=2.0)
+    kept.dispute_colour()
+    kept.absorb_anchor(mug_anchor("cup_3", 0.5, 1.0, colour_seen=1.0), fusion)
+    assert kept.colour_seen == 2.0 and kept.colour_disputed and kept.last_sure_sighting == 2.0
+
+
 def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
     red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
     green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
