@@ -25,6 +25,14 @@ DECLARATIONS = [
 DISCOVERY_SECONDS = 20.0
 
 
+def wait_until(condition, seconds: float) -> bool:
+    """Poll ``condition`` until it holds or ``seconds`` pass; the caller asserts what it needs."""
+    deadline = time.monotonic() + seconds
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return condition()
+
+
 def start_knowledge_base(node_process, namespace: str, store: str):
     return node_process("knowledge_base", "--ros-args", "-r", f"__ns:={namespace}", "-p", f"store:={store}")
 
@@ -36,21 +44,23 @@ def test_a_client_hears_other_writers_and_refusals_leave_the_node_running(node_p
     try:
         heard: list = []
         listener.subscribe(heard.append)
-        # The change topic is volatile, like any event stream: wait until the listener's
-        # subscription and the node's publisher have found each other before writing.
-        topic = f"{namespace}/knowledge_changes"
-        deadline = time.monotonic() + 20.0
-        while time.monotonic() < deadline and not (
-            listener._node.count_publishers(topic) and writer._node.count_subscribers(topic)  # noqa: SLF001
-        ):
-            time.sleep(0.05)
-        time.sleep(0.5)
+        # The change topic is volatile, like any event stream: a batch published before the node's
+        # publisher has matched the listener is lost. Graph counts only say what each client sees,
+        # not what the node's publisher has matched, so prove the stream live with probe types,
+        # each a new change, until the listener hears one.
+        deadline = time.monotonic() + DISCOVERY_SECONDS
+        probes = 0
+        while not heard and time.monotonic() < deadline:
+            probes += 1
+            writer.apply([Change.save(PddlType(f"probe_{probes}"))])
+            wait_until(lambda: bool(heard), seconds=0.5)
+        assert heard, f"no change batch heard within {DISCOVERY_SECONDS} s ({probes} probes)"
+        wait_until(lambda: len(heard) >= probes, seconds=2.0)  # late echoes of earlier probes
+        heard.clear()
         writer.apply(DECLARATIONS)
         writer.apply([Change.save(PddlObject("cup_1", "cup")),
                       Change.save(Proposition("seen", ("cup_1",), provenance=Provenance.PERCEIVED))])
-        deadline = time.monotonic() + 10.0
-        while len(heard) < 2 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_until(lambda: len(heard) >= 2, seconds=10.0)
         assert [len(batch) for batch in heard] == [2, 2], heard
         assert listener.propositions_about("cup_1") == (
             Proposition("seen", ("cup_1",), provenance=Provenance.PERCEIVED),)
