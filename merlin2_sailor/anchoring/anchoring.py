@@ -41,6 +41,7 @@ from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, regi
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, sightings_doubled
+from merlin2_sailor.anchoring.match_explanation import matched_over
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.matching_table import (
     Embedder,
@@ -245,8 +246,9 @@ class Anchoring:
                 # Its colour cannot be held to the anchor's: it neither checks the anchor's colour
                 # nor joins it (it may be another object's, standing in its place).
                 percept = dataclasses.replace(percept, colour=None)
+            why = matched_over(table, row, column) if anchor.state is AnchorState.MISSING else ""
             reacquire(anchor, percept, changes, config.fusion, config.lifecycle, config.expectation_tolerance,
-                      continued=bool(table.continuations[row, column]), partial=partial[row])
+                      continued=bool(table.continuations[row, column]), partial=partial[row], scored=why)
             note_jump(anchor, before, stamp, config.repair.place_jump, config.repair.place_review)
             self._index.refresh(anchor)
             symbols[row] = anchor.symbol

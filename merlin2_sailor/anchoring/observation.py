@@ -42,9 +42,10 @@ def acquire(
 
 def reacquire(
     anchor: Anchor, percept: Percept, changes: FrameChanges, fusion: FusionConfig, lifecycle: LifecycleConfig,
-    expectation_tolerance: float, continued: bool, partial: bool = False,
+    expectation_tolerance: float, continued: bool, partial: bool = False, scored: str = "",
 ) -> None:
-    """Fuse ``percept`` into ``anchor`` (the caller refreshes the index)."""
+    """Fuse ``percept`` into ``anchor`` (the caller refreshes the index); ``scored``: why it took
+    the view, for the event (:func:`~.match_explanation.matched_over`; empty: not said)."""
     # A search for a missing anchor ends only once the anchor is back (see after_sighting):
     # one false detection in the searched disc must not end the search.
     searching = anchor.expectation is not None and anchor.expectation.is_search
@@ -65,7 +66,7 @@ def reacquire(
     changes.reacquired.append(anchor)
     changes.event(
         AnchorEventKind.REACQUIRED, anchor.symbol, was_missing=was_missing, tracker_id=percept.tracker_id,
-        tracker_continued=continued,
+        tracker_continued=continued, **({"scored": scored} if scored else {}),
     )
     if became_confirmed:
         changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="seen", times_seen=anchor.times_seen)

@@ -309,8 +309,9 @@ class AnchoringNode(Node):
         tentative = {symbol for symbol, view in named.items() if view.state is AnchorState.TENTATIVE}
         header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self._world_frame)
         self._events_publisher.publish(events_to_message(result.events, class_names, header))
-        for event in result.events:  # a running account; reacquisitions would flood it
-            if event.kind is not AnchorEventKind.REACQUIRED:
+        for event in result.events:  # a running account; reacquisitions would flood it, but not those of
+            # missing anchors: each may be a wrong identity in the making, and says why it took the view
+            if event.kind is not AnchorEventKind.REACQUIRED or event.details.get("was_missing"):
                 # Tentative said out loud: a false detection makes one, and it goes unconfirmed.
                 status = " [tentative]" if (event.kind is AnchorEventKind.ACQUIRED
                                             and event.symbol in tentative) else ""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -238,11 +239,34 @@ def test_missing_anchor_is_restored_when_seen_again(make_anchoring, maker, kitch
     assert anchoring.get("cup_1").state is AnchorState.MISSING
     first = anchoring.process([maker.percept(cup, 3.0)], camera_view(), 3.0)
     assert first.percept_symbols == ("cup_1",) and first.events[0].details["was_missing"] is True
+    assert re.fullmatch(r"\d\.\d\d, no other candidate", first.events[0].details["scored"])
     assert anchoring.get("cup_1").state is AnchorState.MISSING  # once could be a false detection
     result = anchoring.process([maker.percept(cup, 3.0 + FRAME)], camera_view(), 3.0 + FRAME)
     assert result.percept_symbols == ("cup_1",)
     assert anchoring.get("cup_1").state is AnchorState.CONFIRMED
     assert [e.kind for e in result.events] == [AnchorEventKind.REACQUIRED, AnchorEventKind.CONFIRMED]
+
+
+def test_a_missing_anchor_that_takes_a_view_says_which_other_anchor_it_took_it_over(make_anchoring, maker, twin_mugs):
+    """The evidence a wrong identity in the making leaves: the score, and the best other anchor of
+    the class the view could have gone to (its state, how far, its score). Reacquisitions of
+    anchors that were not missing say nothing more."""
+    anchoring = make_anchoring()
+    left, right = twin_mugs["left_mug"], twin_mugs["right_mug"]
+    for frame in range(2):
+        result = anchoring.process([maker.percept(left, frame * FRAME), maker.percept(right, frame * FRAME)],
+                                   camera_view(), frame * FRAME)
+    assert all("scored" not in event.details for event in result.events)
+    anchoring.process([maker.percept(right, 2 * FRAME)], camera_view(), 2 * FRAME)
+    assert anchoring.get("cup_1").state is AnchorState.MISSING
+    result = anchoring.process([maker.percept(left, 3.0), maker.percept(right, 3.0)], camera_view(), 3.0)
+    reacquired = {event.symbol: event.details for event in result.events if event.kind is AnchorEventKind.REACQUIRED}
+    assert "scored" not in reacquired["cup_2"]
+    explained = r"(\d\.\d\d) over cup_2 \(confirmed, (\d+\.\d\d) m\) (-?\d\.\d\d)"
+    match = re.fullmatch(explained, reacquired["cup_1"]["scored"])
+    assert match, reacquired["cup_1"]
+    assert float(match[2]) == pytest.approx(1.0, abs=0.1)  # the twins stand a metre apart
+    assert float(match[1]) > float(match[3])  # the one it took scored better
 
 
 def test_never_confirmed_anchor_is_forgotten_sooner(make_anchoring, maker, kitchen):
