@@ -244,8 +244,10 @@ class Anchoring:
             if percept.colour is not None and anchor.colour_unchecked(stamp, config.colour) \
                     and anchor.colour_untellable(percept, config.colour):
                 # Its colour cannot be held to the anchor's: it neither checks the anchor's colour
-                # nor joins it (it may be another object's, standing in its place).
+                # nor joins it (it may be another object's, standing in its place), nor says the
+                # anchor is there until a view of its colour does.
                 percept = dataclasses.replace(percept, colour=None)
+                anchor.doubt_unverified(percept.stamp)
             why = matched_over(table, row, column) if anchor.state is AnchorState.MISSING else ""
             reacquire(anchor, percept, changes, config.fusion, config.lifecycle, config.expectation_tolerance,
                       continued=bool(table.continuations[row, column]), partial=partial[row], scored=why)

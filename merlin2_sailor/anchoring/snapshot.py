@@ -67,6 +67,7 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
         "colour_seen": anchor.colour_seen,
         "colour_disputed": bool(anchor.colour_disputed),
         "doubted_sightings": None if anchor.doubted_sightings is None else list(anchor.doubted_sightings),
+        "unverified_sightings": None if anchor.unverified_sightings is None else list(anchor.unverified_sightings),
         "missed_frames": int(anchor.missed_frames),
         "recovery_sightings": int(anchor.recovery_sightings),
         "missing_since": anchor.missing_since,
@@ -84,7 +85,7 @@ def anchor_to_dict(anchor: Anchor) -> dict[str, Any]:
 
 
 def _doubted(value: Any) -> tuple[float, float] | None:
-    """The doubted sightings' window, from a snapshot (None where an older one has none)."""
+    """A window of doubted (or unverified) sightings, from a snapshot (None where an older one has none)."""
     if value is None:
         return None
     start, end = (float(stamp) for stamp in value)
@@ -117,6 +118,7 @@ def anchor_from_dict(data: Mapping[str, Any]) -> Anchor:
             else float(data["colour_seen"]),
             colour_disputed=bool(data.get("colour_disputed", False)) and "colour_by_size" in data,
             doubted_sightings=_doubted(data.get("doubted_sightings")),
+            unverified_sightings=_doubted(data.get("unverified_sightings")),
             visible=False,
             missed_frames=int(data.get("missed_frames", 0)),
             recovery_sightings=int(data.get("recovery_sightings", 0)),
