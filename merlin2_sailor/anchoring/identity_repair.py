@@ -58,7 +58,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_agree, colours_differ
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ, colours_agree
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.errors import ConfigurationError
@@ -322,7 +322,7 @@ class IdentityRepair:
         second anchor of an object seen there all along, after a percept slid off its first)."""
         return any(
             other is not lost and other.class_name == candidate.class_name and other.first_seen < candidate.first_seen
-            and not colours_differ(other.colour, candidate.colour, self.colour)
+            and not anchor_colours_differ(other, candidate, self.colour)
             for other in self._near(candidate, index)
         )
 
@@ -413,7 +413,7 @@ class IdentityRepair:
             and candidate.expectation is None
             and candidate.first_seen >= last_sighting
             and self._could_have_been_carried(candidate, lost, candidate.first_seen - last_sighting)
-            and not colours_differ(candidate.colour, lost.colour, self.colour)
+            and not anchor_colours_differ(candidate, lost, self.colour)
         )
 
     def _could_have_been_carried(self, candidate: Anchor, lost: Anchor, gap: float) -> bool:

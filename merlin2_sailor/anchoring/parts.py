@@ -51,7 +51,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, turned_extent
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
 from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS, PARTIAL_FOOTPRINT_SHARE
 
@@ -167,5 +167,5 @@ def _may_be_parts(anchor: Anchor, other: Anchor, colour: ColourEvidenceConfig) -
         and _trusted(other)
         and other.symbol not in anchor.seen_with
         and anchor.symbol not in other.seen_with
-        and not colours_differ(anchor.colour, other.colour, colour)
+        and not anchor_colours_differ(anchor, other, colour)
     )

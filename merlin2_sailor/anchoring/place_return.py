@@ -29,7 +29,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -98,7 +98,7 @@ def _returns(
     home = float(np.linalg.norm(newcomer.position - anchor.left_place))
     away = float(np.linalg.norm(newcomer.position - anchor.position))
     on_the_place_left = home <= place_jump / 2.0 and away > place_jump
-    return on_the_place_left and not colours_differ(anchor.colour, newcomer.colour, colour)
+    return on_the_place_left and not anchor_colours_differ(anchor, newcomer, colour)
 
 
 def trade_places(decision: Return) -> None:

@@ -36,7 +36,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
 from merlin2_sailor.anchoring.identity_repair import Merge
 from merlin2_sailor.anchoring.matcher import Matcher
 
@@ -104,7 +104,7 @@ def _may_be_one(seen: Anchor, missing: Anchor, colour: ColourEvidenceConfig) -> 
         and missing.expectation is None
         and missing.class_name == seen.class_name
         and seen.first_seen < missing.last_seen
-        and not colours_differ(seen.colour, missing.colour, colour)
+        and not anchor_colours_differ(seen, missing, colour)
     )
 
 

@@ -43,7 +43,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, colours_differ
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.same_space import Duplicate
 
@@ -67,8 +67,7 @@ def decide_stand_ins(
         if stand_in.expectation is not None:
             continue
         originals = [older for older in _beside(stand_in, index, reach)
-                     if _was_away_all_its_life(older, stand_in) and not colours_differ(older.colour, stand_in.colour,
-                                                                                         colour)]
+                     if _was_away_all_its_life(older, stand_in) and not anchor_colours_differ(older, stand_in, colour)]
         if len(originals) != 1:
             continue
         original = originals[0]
