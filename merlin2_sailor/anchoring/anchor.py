@@ -277,11 +277,18 @@ class Anchor:
         centred on the part in view: once the anchor has had a whole view, a partial one keeps it
         alive but moves and resizes it no more; before that, it is the best there is, but weighs
         ``partial_view_variance_factor`` times less. Its crop never joins the appearance gallery.
+        Such a view does not make where an action put the anchor (an expectation: the middle of a
+        searched disc) a perceived position either: the bicycle, found by a search and then sought
+        at the next stop, was seen there only in parts, which left it at that stop's waypoint 0.5 m
+        from the bicycle, as if perceived, when the search moved on (`large_object_wheeled_away`,
+        network, seed 2, 6 December 2026).
         """
         self.times_seen += 1
-        if partial and self.parts_fit is not None:
+        perceived = self.provenance is Provenance.PERCEIVED
+        moves = not partial or self.whole_views == 0
+        if partial and self.parts_fit is not None and perceived:
             self._widen_to(percept)
-        if not partial or self.whole_views == 0:
+        if moves:
             self.position, self.position_variance = fuse_position(
                 self.position, self.position_variance, percept.position, percept.stamp - self.last_seen, config,
                 partial,
@@ -307,8 +314,9 @@ class Anchor:
             self.last_tracker_id = percept.tracker_id
         self.last_seen = max(self.last_seen, percept.stamp)
         self.recent_sightings.append(percept.stamp)
-        self.perceived_position = self.position.copy()
-        self.provenance = Provenance.PERCEIVED
+        if moves or perceived:
+            self.perceived_position = self.position.copy()
+            self.provenance = Provenance.PERCEIVED
         self.visible = True
         self.missed_frames = 0
         self.missing_since = None

@@ -316,6 +316,33 @@ def test_a_search_seen_empty_is_not_retracted_and_clearing_it_restores_the_ancho
     np.testing.assert_array_equal(anchor.position, perceived)
 
 
+@pytest.mark.parametrize("disc_offset", [(1.5, 0.5, 0.0), (-0.8, 1.2, 0.0), (0.6, -0.6, 0.0)])
+def test_views_of_a_part_leave_a_searched_anchor_where_it_was_perceived(make_anchoring, maker, kitchen, disc_offset):
+    """A search moves the lost anchor to the middle of the searched disc; a part of the object seen
+    there (cut by the image's edge) does not make that middle a perceived position: when the search
+    moves on, the anchor goes back to where it was last perceived (`large_object_wheeled_away`,
+    network, seed 2, 6 December 2026: the bicycle was left at a waypoint 0.5 m from it)."""
+    anchoring = make_anchoring()
+    cup = kitchen["red_cup"]
+    seen_twice(anchoring, maker, [cup])
+    lose(anchoring, 1.0)
+    perceived = anchoring.get("cup_1").position.copy()
+    centre = perceived + np.array(disc_offset)
+    anchoring.expect("cup_1", Expectation.at(centre, stamp=1.5, source="find", radius=2.0))
+    part = maker.percept(cup, 2.0, position=perceived + (0.05, 0.0, 0.0))
+    assert anchoring.process([part], None, 2.0, partial=[True]).percept_symbols == ("cup_1",)
+    anchor = anchoring.get("cup_1")
+    assert anchor.state is AnchorState.MISSING  # one sighting does not bring it back
+    np.testing.assert_allclose(anchor.position, centre)  # still where the search looks
+    np.testing.assert_allclose(anchor.perceived_position, perceived)
+    assert anchor.provenance is Provenance.EXPECTED
+    anchoring.clear_expectation("cup_1")
+    np.testing.assert_allclose(anchoring.get("cup_1").position, perceived)
+    # A whole view is perceived wherever the anchor stood.
+    anchoring.process([maker.percept(cup, 3.0)], None, 3.0, partial=[False])
+    assert anchoring.get("cup_1").provenance is Provenance.PERCEIVED
+
+
 def test_only_a_place_can_be_searched():
     with pytest.raises(InvalidInputError, match="radius"):
         Expectation.at((0, 0, 0), stamp=0.0, radius=-1.0)
