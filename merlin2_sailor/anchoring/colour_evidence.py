@@ -457,11 +457,12 @@ def comparable_views_of(model: ColourBySize, size: float, bearing: float | None,
 
 
 class Coloured(Protocol):
-    """What :func:`anchor_colours_differ` reads of an anchor: its whole colour model and its views
-    by size and side."""
+    """What :func:`anchor_colours_differ` reads of an anchor: its whole colour model, its views by
+    size and side, and whether its box was joined from parts of a large object (:mod:`.parts`)."""
 
     colour: ColourModel | None
     colour_by_size: ColourBySize | None
+    parts_fit: np.ndarray | None
 
 
 def side_by_side(first: ColourBySize, second: ColourBySize,
@@ -483,7 +484,14 @@ def anchor_colours_differ(first: Coloured, second: Coloured, config: ColourEvide
     """Whether two anchors' colours show they are different objects: their whole models differ, and
     so do their views from a common size and side, or else the whole models differ by more than
     ``minimum_difference_across_sides`` (see the module docstring). Anchors that kept no views by
-    size and side (restored from an older snapshot) are held to their whole models."""
+    size and side (restored from an older snapshot) are held to their whole models. An anchor whose
+    box was joined from parts of a large object is no colour evidence, as a part's view is not: its
+    views are of whichever faces its parts showed (the wheeled bicycle's joined anchor, seen from
+    the side its lost anchor was known from but four times closer, differed from it by 0.185:
+    `large_object_wheeled_away`, network, seed 2, 6 December 2026; the matching function compares
+    such an anchor without its look for the same reason, :mod:`.anchor_comparison`)."""
+    if first.parts_fit is not None or second.parts_fit is not None:
+        return False
     difference = colour_difference(first.colour, second.colour, config)
     if difference == 0.0:
         return False

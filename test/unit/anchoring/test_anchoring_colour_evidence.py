@@ -750,7 +750,8 @@ def sided_anchor(views: list[tuple[np.ndarray, float]], size: float = 40.0):
         else:
             whole.add(histogram)
         by_side.add(histogram, size, bearing)
-    return dataclasses.make_dataclass("Coloured", ["colour", "colour_by_size"])(whole, by_side)
+    return dataclasses.make_dataclass("Coloured", ["colour", "colour_by_size", ("parts_fit", object, None)])(
+        whole, by_side)
 
 
 #: Bearings (object to camera) of three sides of an object, each at least 100 degrees from the next
@@ -776,6 +777,8 @@ def test_anchors_never_seen_from_a_common_side_differ_only_by_more_than_one_obje
     assert anchor_colours_differ(first, same_side, config)
     # Anchors restored from an older snapshot, without views by side, are held to their whole models.
     assert anchor_colours_differ(first, dataclasses.replace(second, colour_by_size=None), config)
+    # An anchor joined from parts of a large object is no colour evidence, from any side.
+    assert not anchor_colours_differ(first, dataclasses.replace(same_side, parts_fit=np.ones(3)), config)
     # The threshold is a setting, at least the difference that counts from a common side.
     assert anchor_colours_differ(first, second, ColourEvidenceConfig(minimum_difference_across_sides=0.1))
     with pytest.raises(ConfigurationError, match="across_sides"):
