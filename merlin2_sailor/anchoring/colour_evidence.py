@@ -109,6 +109,7 @@ second; a view of its own colour in between is fused as usual, and ends the susp
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -466,18 +467,17 @@ class Coloured(Protocol):
 
 
 def side_by_side(first: ColourBySize, second: ColourBySize,
-                 config: ColourEvidenceConfig) -> list[tuple[ColourModel, ColourModel]]:
+                 config: ColourEvidenceConfig) -> Iterator[tuple[ColourModel, ColourModel]]:
     """For every band of sizes and sector of bearings either anchor saw, both anchors' views of
     about that size from about that side (``comparable_size``, ``comparable_bearing``, as a single
-    view is held to), where both have some."""
-    pairs = []
+    view is held to), where both have some; one at a time, so a caller looking for one that
+    differs stops there."""
     for band, sector in sorted(set(first.bands) | set(second.bands), key=view_key_order):
         bearing = None if sector is None else sector_centre(sector)
         own = first.comparable(band_centre(band), config.comparable_size, bearing, config.comparable_bearing)
         other = second.comparable(band_centre(band), config.comparable_size, bearing, config.comparable_bearing)
         if own is not None and other is not None:
-            pairs.append((own, other))
-    return pairs
+            yield own, other
 
 
 def anchor_colours_differ(first: Coloured, second: Coloured, config: ColourEvidenceConfig) -> bool:

@@ -35,6 +35,7 @@ import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, view_scale
 from merlin2_sailor.anchoring.gallery import view_scales
+from merlin2_sailor.anchoring.match_explanation import best_candidate
 from merlin2_sailor.anchoring.matching_table import MatchingTable
 from merlin2_sailor.errors import ConfigurationError
 
@@ -97,16 +98,14 @@ def nearest_anchor(table: MatchingTable, row: int, taken: np.ndarray) -> str:
     scored it: the one it stood in the place of is the one that matters). Empty when no anchor of
     its class passed the gate and none was ruled out."""
     percept = table.percepts[row]
-    columns = [column for column, anchor in enumerate(table.anchors)
-               if not table.gated[row, column] and anchor.class_name == percept.class_name]
+    column = best_candidate(table, row)
     # Gated by colour: the view's colour ruled out an anchor whose own went unchecked a while.
     ruled_out = table.colour_ruled_out
     by_colour = [] if ruled_out is None else sorted(table.anchors[column].symbol
                                                     for column in np.flatnonzero(ruled_out[row]))
     colour_text = f"{', '.join(by_colour)} ruled out by colour" if by_colour else ""
-    if not columns:
+    if column is None:
         return colour_text
-    column = max(columns, key=lambda candidate: table.scores[row, candidate])
     anchor = table.anchors[column]
     text = f"{anchor.symbol} scored {table.scores[row, column]:.2f}"
     smallest = smallest_view(anchor)

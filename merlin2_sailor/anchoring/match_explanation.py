@@ -16,17 +16,24 @@ import numpy as np
 from merlin2_sailor.anchoring.matching_table import MatchingTable
 
 
+def best_candidate(table: MatchingTable, row: int, excluded: int | None = None) -> int | None:
+    """The column of the anchor of the view's class that passed the gate for it with the best
+    score, leaving out ``excluded``; None when there is none."""
+    class_name = table.percepts[row].class_name
+    columns = [column for column, anchor in enumerate(table.anchors)
+               if column != excluded and not table.gated[row, column] and anchor.class_name == class_name]
+    return max(columns, key=lambda column: table.scores[row, column]) if columns else None
+
+
 def matched_over(table: MatchingTable, row: int, column: int) -> str:
     """``"0.83 over cup_4 (confirmed, 0.31 m) 0.79"``: the pair's score, then the best other
     anchor of the view's class that passed the gate for it (its state, how far the view stands
     from it, its score), or ``"0.83, no other candidate"``."""
     percept = table.percepts[row]
     score = f"{table.scores[row, column]:.2f}"
-    others = [other for other, anchor in enumerate(table.anchors)
-              if other != column and not table.gated[row, other] and anchor.class_name == percept.class_name]
-    if not others:
+    best = best_candidate(table, row, excluded=column)
+    if best is None:
         return f"{score}, no other candidate"
-    best = max(others, key=lambda other: table.scores[row, other])
     anchor = table.anchors[best]
     distance = float(np.linalg.norm(np.asarray(percept.position) - anchor.position))
     return f"{score} over {anchor.symbol} ({anchor.state.value}, {distance:.2f} m) {table.scores[row, best]:.2f}"
