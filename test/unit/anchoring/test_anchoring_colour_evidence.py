@@ -811,3 +811,23 @@ def test_a_large_object_found_from_another_side_than_it_was_known_is_found(found
                                                       radius=1.5)).events
     merged = [(AnchorEventKind.FORGOTTEN, "dog_2"), (AnchorEventKind.CONFIRMED, "dog_1")]
     assert [(event.kind, event.symbol) for event in events] == (merged if found else [])
+
+
+@pytest.mark.parametrize(("own", "other", "apart"), [(RED, GREEN, 0.3), (BLUE, 16, 0.4), (3, 9, 0.25)])
+def test_a_missing_anchor_taking_a_view_held_from_the_anchor_in_its_place_says_so(own, other, apart) -> None:
+    """The first view of another colour standing in a confirmed anchor's place is held from it;
+    a missing look-alike of the view's colour nearby may take it, and its reacquisition names the
+    nearer anchor the view was kept from and why (twin_removed_from_the_shelf, scenario suite,
+    network, seed 0, 5 December 2026: which rule kept the twin's anchor away was not known)."""
+    here = SceneObject("here", "cup", KITCHEN, colour=mug_colour(own))
+    beside = SceneObject("beside", "cup", tuple(np.asarray(KITCHEN) + (0.0, apart, 0.0)), colour=mug_colour(other))
+    anchoring, maker = rules(), PerceptMaker(seed=5)
+    here_symbol, beside_symbol = see(anchoring, maker, [here, beside], 0.0).percept_symbols
+    see(anchoring, maker, [here], 1.0, frames=2)
+    assert anchoring.get(beside_symbol).state is AnchorState.MISSING
+    stranger = SceneObject("stranger", "cup", KITCHEN, colour=mug_colour(other))
+    result = anchoring.process([maker.percept(stranger, 60.0)], camera_view(), 60.0)
+    assert result.percept_symbols == (beside_symbol,)
+    scored = next(event.details["scored"] for event in result.events if event.kind is AnchorEventKind.REACQUIRED)
+    assert f"nearer, kept from it: {here_symbol} (confirmed, 0.0" in scored, scored
+    assert scored.endswith("held apart by a first view of another colour"), scored
