@@ -451,6 +451,30 @@ def sized_view_differs(model: ColourBySize | None, histogram: np.ndarray | None,
     return view_differs(comparable_views_of(model, size, bearing, config), histogram, config)
 
 
+def view_gap_text(model: ColourBySize | None, histogram: np.ndarray | None, size: float,
+                  config: ColourEvidenceConfig, bearing: float | None = None) -> str:
+    """``"0.14 in the hue window at 120 deg: 0.31 in its 6 views, 0.17 in this one"``: how one whole
+    view's colour differs from the anchor's views it is held to (:func:`sized_view_differs`), for a
+    log line that must let a wrong ruling be traced to its numbers; empty when it does not differ."""
+    if histogram is None or model is None:
+        return ""
+    near = comparable_views_of(model, size, bearing, config)
+    difference = colour_difference(near, ColourModel.of(histogram), config)
+    if near is None or difference <= 0.0:
+        return ""
+    view = colour_windows(histogram)
+    window = int(np.argmax(np.where(np.abs(near.mean - view) >= difference, np.abs(near.mean - view), -1.0)))
+    return (f"{difference:.2f} in the {window_name(window)}: {near.mean[window]:.2f} in its {near.views} views, "
+            f"{view[window]:.2f} in this one")
+
+
+def window_name(window: int) -> str:
+    """What a colour window of :func:`colour_windows` covers, in words."""
+    if window < HUE_BINS:
+        return f"hue window at {round(window * 360 / HUE_BINS)} deg"
+    return f"{('dark', 'mid', 'light')[window - HUE_BINS]} grey bin"
+
+
 def comparable_views_of(model: ColourBySize, size: float, bearing: float | None,
                         config: ColourEvidenceConfig) -> ColourModel | None:
     """The anchor's views a single view of ``size`` pixels, seen from ``bearing``, is held to."""

@@ -61,10 +61,12 @@ def kept_from(table: MatchingTable, row: int, column: int) -> str:
 
 def _why_gated(table: MatchingTable, row: int, column: int) -> str:
     """The rule of :class:`MatchingTable` that kept a view from an anchor of its class."""
+    gap = table.colour_gaps.get((row, column), "")
+    gap = f" ({gap})" if gap else ""
     if table.held is not None and table.held[row, column]:
-        return "held apart by a first view of another colour"
+        return f"held apart by a first view of another colour{gap}"
     if table.colour_ruled_out is not None and table.colour_ruled_out[row, column]:
-        return "ruled out by colour"
+        return f"ruled out by colour{gap}"
     claimed = table.shortcut & table.continuations[:, column]
     claimed[row] = False
     if claimed.any():

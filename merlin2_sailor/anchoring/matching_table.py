@@ -55,7 +55,12 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState, view_bearing, view_scale
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.assignment import apply_tracker_continuity, tracker_continuations
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs, view_differs
+from merlin2_sailor.anchoring.colour_evidence import (
+    ColourEvidenceConfig,
+    sized_view_differs,
+    view_differs,
+    view_gap_text,
+)
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.partial_view import comparable_views
@@ -160,6 +165,9 @@ class MatchingTable:
     held: np.ndarray | None = None
     """(P, A) bool: the pairs such a first view held apart: gated too, and the view, unless another
     anchor takes it, is left unresolved rather than anchored anew (None: no colour was asked)."""
+    colour_gaps: Mapping[tuple[int, int], str] = dataclasses.field(default_factory=dict)
+    """{(row, column): how the view's colour differed} for the pairs held apart or ruled out by a
+    view of another colour (:func:`~.colour_evidence.view_gap_text`), for the log."""
 
 
 class MatchingTableBuilder:
@@ -247,13 +255,14 @@ class MatchingTableBuilder:
         disputed: tuple[Anchor, ...] = ()
         suspected: tuple[Anchor, ...] = ()
         ruled_out = held = None
+        colour_gaps: dict[tuple[int, int], str] = {}
         if whole is not None:
             # Held to each anchor as appearance is: a part of a large object (a view measuring 0.59 m
             # of a bicycle's 1.68 m) showed another colour than the whole bicycle's views and ruled
             # its anchor out, one object under two symbols (scenario suite, `twin_moved`, network,
             # seed 0, 5 December 2026).
             whole_for = comparable if comparable is not None else comparable_views(columns.sizes, whole, anchors)
-            ruled_out, differing, held = self._ruled_out_by_colour(percepts, anchors, whole_for, ~gated)
+            ruled_out, differing, held, colour_gaps = self._ruled_out_by_colour(percepts, anchors, whole_for, ~gated)
             apart = ruled_out | held
             scores[apart] = self.config.gated_score
             gated |= apart
@@ -268,7 +277,7 @@ class MatchingTableBuilder:
                 continuations &= ~searched_apart
                 ruled_out |= searched_apart
         return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded, disputed, ruled_out,
-                             suspected, held)
+                             suspected, held, colour_gaps)
 
     def _ungated_pairs(self, percepts: PerceptColumns, index: AnchorIndex) -> tuple[np.ndarray, np.ndarray]:
         """(rows, slots) of the pairs that pass the gate, computed on the index's arrays only.
@@ -297,20 +306,21 @@ class MatchingTableBuilder:
 
     def _ruled_out_by_colour(
         self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: np.ndarray, open_pairs: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(ruled out, differing, held), each (P, A): the pairs gated by colour; among them those
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[tuple[int, int], str]]:
+        """(ruled out, differing, held, gaps), the first three (P, A): the pairs gated by colour; among them those
         whose percept, a whole view (``whole``: (P, A), of the anchor's object) with a colour
         standing in the anchor's place, differed from an
         anchor whose colour had gone unchecked for the configured absence (or was disputed
         already) and confirmed a suspicion
         a first such view raised (the others ruled out are views without a colour, far or cut
         off, of what stands where a disputed anchor was); and the pairs of a view that differed
-        but only raised the suspicion."""
+        but only raised the suspicion; ``gaps`` says, for the last two, how the colour differed."""
         ruled_out = np.zeros(open_pairs.shape, dtype=bool)
         differing = np.zeros(open_pairs.shape, dtype=bool)
         held = np.zeros(open_pairs.shape, dtype=bool)
+        gaps: dict[tuple[int, int], str] = {}
         if self.colour.minimum_views == 0 or not any(a.colour is not None or a.colour_disputed for a in anchors):
-            return ruled_out, differing, held  # no anchor has a colour to tell by: spare the loop over pairs
+            return ruled_out, differing, held, gaps  # no anchor has a colour to tell by: spare the loop over pairs
         in_place = self._in_place(percepts, anchors)
         for row, column in zip(*np.nonzero(open_pairs), strict=True):
             percept, anchor = percepts[row], anchors[column]
@@ -321,12 +331,14 @@ class MatchingTableBuilder:
                         anchor.colour_suspected, percept.stamp)
                     differing[row, column] = confirmed
                     held[row, column] = not confirmed
+                    gaps[row, column] = view_gap_text(anchor.colour_by_size, percept.colour, view_scale(percept),
+                                                      self.colour, view_bearing(percept))
                 ruled_out[row, column] = differing[row, column]
             else:
                 # Nothing coloured has been its colour there since: a view without a colour, or with
                 # one that cannot be held to the anchor's, is no way back.
                 ruled_out[row, column] = anchor.colour_disputed and anchor.state is AnchorState.MISSING
-        return ruled_out, differing, held
+        return ruled_out, differing, held, gaps
 
     def _searched_another_colour(
         self, percepts: tuple[Percept, ...], anchors: tuple[Anchor, ...], whole: np.ndarray, open_pairs: np.ndarray,

@@ -12,6 +12,7 @@ import dataclasses
 import itertools
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -830,4 +831,11 @@ def test_a_missing_anchor_taking_a_view_held_from_the_anchor_in_its_place_says_s
     assert result.percept_symbols == (beside_symbol,)
     scored = next(event.details["scored"] for event in result.events if event.kind is AnchorEventKind.REACQUIRED)
     assert f"nearer, kept from it: {here_symbol} (confirmed, 0.0" in scored, scored
-    assert scored.endswith("held apart by a first view of another colour"), scored
+    gap = re.search(r"held apart by a first view of another colour \((\d\.\d\d) in the hue window at (\d+) deg: "
+                    r"(\d\.\d\d) in its (\d+) views, (\d\.\d\d) in this one\)$", scored)
+    assert gap, scored
+    difference, window, known, views, seen = gap.groups()
+    assert float(difference) == pytest.approx(abs(float(known) - float(seen)), abs=0.011)
+    assert float(difference) > ColourEvidenceConfig().minimum_difference and int(views) >= 3
+    # the window named is one of the two colours' own (a mug's colour sits in one hue bin)
+    assert int(window) // 20 in {(own - 1) % 18, own, (own + 1) % 18, (other - 1) % 18, other, (other + 1) % 18}
