@@ -77,6 +77,11 @@ class AnchorReport:
     indistinguishable_from: tuple[str, ...] = ()
     """While missing: anchors a search found that the anchoring layer cannot tell from this one
     (look-alikes). Its identity is unknown: a finder must not claim any of them is it."""
+    found_by_look_alone: str = ""
+    """While missing: an anchor a search found that looks like this one, where the camera had never
+    watched before (a copy may have stood there all along). The anchoring layer takes it for this
+    one only when the finder, having looked everywhere else and seen no other copy, concludes the
+    search (:meth:`AnchoringPort.conclude_search`); empty: none."""
 
     def seen_since(self, baseline: AnchorReport | None) -> bool:
         """Whether the camera reacquired this anchor after ``baseline`` was taken (None: ever),
@@ -114,6 +119,12 @@ class AnchoringPort(Protocol):
 
     def clear_expectation(self, symbol: str, source: str) -> None:
         """Withdraw an expectation that no longer applies."""
+        ...
+
+    def conclude_search(self, symbol: str, source: str) -> bool:
+        """Say that a search for ``symbol`` has looked everywhere: the anchoring layer takes the
+        anchor it found by look alone (``found_by_look_alone``) for it, unless a copy turned up
+        meanwhile. Whether it did."""
         ...
 
 

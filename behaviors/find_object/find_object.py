@@ -24,6 +24,17 @@ blackboard), the robot searches for it:
    wrong object under the symbol): RETURNING to ``origin`` (so the ``robot_at(origin)`` the dispatcher
    restores after an abort is true; ``return_on_failure``), then GIVING_UP: aborted, naming
    every stop searched. A stop the robot cannot reach is a warning and the search goes on.
+5. Found by look alone: a search may find, where the camera had never watched before, an object
+   that looks like the sought one (the anchor reports ``found_by_look_alone``). It may be the
+   sought object, moved there, or a copy of it that stood there all along, and the look cannot
+   tell: the anchoring layer does not take it, the sought anchor stays missing, and the search
+   records the candidate (and the waypoint nearest it) and goes on through the remaining stops.
+   A copy seen at a later stop makes the two indistinguishable: the search ends as in 4. Only
+   when every stop has been searched and no other copy turned up anywhere searched does it take
+   the candidate: PLANNING_CONCLUSION, GOING_TO_CANDIDATE (its waypoint, facing it), CONCLUDING
+   (``conclude_search``, then wait up to ``reacquire_timeout`` for the sought anchor to be
+   reacquired) and success there as in 3. Refused, not reacquired in time, or the candidate's
+   waypoint unreachable: as in 4. A search for a class has no anchor to conclude on.
 """
 
 from __future__ import annotations
@@ -84,6 +95,11 @@ class Search:
     indistinguishable_from: tuple[str, ...] = ()
     """Anchors the anchoring layer found and cannot tell from the sought one (look-alikes): the
     search ends there, unsuccessful, rather than claim one of them is it."""
+    look_alone: str = ""
+    """The anchor a search found that looks like the sought one, where the camera had never watched
+    before (``found_by_look_alone``): taken only once every stop is searched and no copy turned up."""
+    look_alone_at: str | None = None
+    """The waypoint nearest that candidate, where the search concludes (None: not known)."""
 
     @property
     def sought(self) -> str:
@@ -244,18 +260,113 @@ def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
         if state.is_canceled():
             return CANCEL
         sought = context.anchoring.get_anchor(search.symbol) if search.symbol else None
-        if sought is not None and sought.indistinguishable_from:
-            search.indistinguishable_from = sought.indistinguishable_from
-            context.log("warning", f"{search.sought}: cannot tell it from {', '.join(sought.indistinguishable_from)} "
-                                "(they look alike); its identity is unknown")
+        if note_indistinguishable(context, search, sought):
             return NOT_HERE
+        note_look_alone(context, search, sought)
         context.log("info", f"{search.sought} is not at {stop}")
         return NOT_HERE
-    declare_robot_at(context.store, stop)
-    blackboard[FOUND_SYMBOL_KEY] = found[-1].symbol
+    return found_here(state, blackboard, found[-1])
+
+
+def found_here(state: BehaviorState, blackboard: Blackboard, anchor: AnchorReport) -> str:
+    """The search ends at this stop: the robot is declared here and the find recorded."""
+    stop = blackboard[STOP_KEY]
+    declare_robot_at(state.context.store, stop)
+    blackboard[FOUND_SYMBOL_KEY] = anchor.symbol
     blackboard[FOUND_AT_KEY] = stop
-    context.log("info", f"found {found[-1].symbol} at {stop}")
+    state.context.log("info", f"found {anchor.symbol} at {stop}")
     return SUCCEED
+
+
+def note_indistinguishable(context: BehaviorContext, search: Search, sought: AnchorReport | None) -> bool:
+    """Whether the sought anchor is reported indistinguishable from look-alikes (then recorded, so
+    the search gives up saying so)."""
+    if sought is None or not sought.indistinguishable_from:
+        return False
+    search.indistinguishable_from = sought.indistinguishable_from
+    context.log("warning", f"{search.sought}: cannot tell it from {', '.join(sought.indistinguishable_from)} "
+                           "(they look alike); its identity is unknown")
+    return True
+
+
+def note_look_alone(context: BehaviorContext, search: Search, sought: AnchorReport | None) -> None:
+    """Record the candidate the sought anchor reports found by look alone, and the waypoint nearest
+    it, once: the search goes on, since a copy may have stood there all along."""
+    if sought is None or not sought.found_by_look_alone or sought.found_by_look_alone == search.look_alone:
+        return
+    search.look_alone = sought.found_by_look_alone
+    candidate = context.anchoring.get_anchor(search.look_alone)
+    search.look_alone_at = None if candidate is None else context.places.nearest_waypoint(
+        candidate.position[0], candidate.position[1])
+    where = search.look_alone_at or "an unknown place"
+    context.log("info", f"{search.symbol} looks like {search.look_alone} at {where}, "
+                        "where the camera had never looked before: a copy may have stood there all along; "
+                        "looking at the remaining stops before taking it")
+
+
+def plan_conclusion(state: BehaviorState, blackboard: Blackboard) -> str:
+    """Every stop searched: drive to the candidate found by look alone, if the sought anchor still
+    reports it and no copy turned up; else EXHAUSTED (the search gives up)."""
+    context = state.context
+    search: Search = blackboard[SEARCH_KEY]
+    if not search.symbol or search.indistinguishable_from:
+        return EXHAUSTED
+    sought = context.anchoring.get_anchor(search.symbol)
+    if note_indistinguishable(context, search, sought):
+        return EXHAUSTED
+    note_look_alone(context, search, sought)
+    if not search.look_alone:
+        return EXHAUSTED
+    if sought is None or sought.found_by_look_alone != search.look_alone:
+        context.log("info", f"{search.look_alone} is no longer taken for {search.symbol}: not concluding on it")
+        return EXHAUSTED
+    candidate = context.anchoring.get_anchor(search.look_alone)
+    stop = search.look_alone_at if candidate is None else context.places.nearest_waypoint(
+        candidate.position[0], candidate.position[1])
+    if candidate is None or stop is None:
+        context.log("info", f"{search.look_alone}, which looks like {search.symbol}, is nowhere on the map: "
+                            "not concluding on it")
+        return EXHAUSTED
+    search.look_alone_at = stop
+    target = place_target(context, stop)
+    if context.places.get(stop).yaw is None:
+        facing = target.pose.facing(candidate.position[0], candidate.position[1])
+        target = Target(stop, Pose2D(target.pose.x, target.pose.y, facing.yaw))  # as next_stop faces a sighting
+    blackboard[STOP_KEY] = stop
+    blackboard[TARGET_KEY] = target
+    context.log("info", f"no other copy of {search.symbol} anywhere searched: going back to {search.look_alone} "
+                        f"at {stop} to take it")
+    return NEXT
+
+
+def conclude(state: BehaviorState, blackboard: Blackboard) -> str:
+    """At the candidate: ask the anchoring layer to take it for the sought anchor, and wait for the
+    sought anchor to be reacquired; NOT_HERE when it was not (the search gives up)."""
+    context = state.context
+    search: Search = blackboard[SEARCH_KEY]
+    stop = blackboard[STOP_KEY]
+    try:
+        taken = context.anchoring.conclude_search(search.symbol, FIND_SOURCE)
+    except BehaviorError as error:
+        warn(context, blackboard, f"cannot conclude the search for {search.symbol} on {search.look_alone}: {error}")
+        return NOT_HERE
+    found: list[AnchorReport] = []
+
+    def seen() -> bool:
+        anchor = reacquired(context, search)
+        if anchor is not None:
+            found.append(anchor)
+        return anchor is not None
+
+    if taken and wait_until(seen, context.config.reacquire_timeout, context.config.poll_period, state):
+        return found_here(state, blackboard, found[-1])
+    if state.is_canceled():
+        return CANCEL
+    if note_indistinguishable(context, search, context.anchoring.get_anchor(search.symbol)):
+        return NOT_HERE
+    why = "the anchoring layer did not take it" if not taken else "it was not reacquired in time"
+    context.log("info", f"{search.look_alone} at {stop} is not taken for {search.symbol}: {why}")
+    return NOT_HERE
 
 
 def plan_return(state: BehaviorState, blackboard: Blackboard) -> str:
@@ -291,7 +402,7 @@ def find_object_state_machine(context: BehaviorContext) -> StateMachine:
     machine.add_state(
         "NEXT_STOP",
         CallbackState(context, next_stop, (NEXT, EXHAUSTED, ABORT, CANCEL)),
-        {NEXT: "GOING_TO_STOP", EXHAUSTED: "RETURNING_HOME"},
+        {NEXT: "GOING_TO_STOP", EXHAUSTED: "PLANNING_CONCLUSION"},
     )
     machine.add_state(
         "GOING_TO_STOP",
@@ -314,6 +425,21 @@ def find_object_state_machine(context: BehaviorContext) -> StateMachine:
         "CHECKING",
         CallbackState(context, check_here, (SUCCEED, NOT_HERE, ABORT, CANCEL)),
         {NOT_HERE: "NEXT_STOP"},
+    )
+    machine.add_state(
+        "PLANNING_CONCLUSION",
+        CallbackState(context, plan_conclusion, (NEXT, EXHAUSTED, ABORT, CANCEL)),
+        {NEXT: "GOING_TO_CANDIDATE", EXHAUSTED: "RETURNING_HOME"},
+    )
+    machine.add_state(
+        "GOING_TO_CANDIDATE",
+        GoTo(context, TARGET_KEY, failed_outcome=UNREACHABLE),
+        {SUCCEED: "CONCLUDING", UNREACHABLE: "RETURNING_HOME"},
+    )
+    machine.add_state(
+        "CONCLUDING",
+        CallbackState(context, conclude, (SUCCEED, NOT_HERE, ABORT, CANCEL)),
+        {NOT_HERE: "RETURNING_HOME"},
     )
     machine.add_state(
         "RETURNING_HOME",

@@ -51,6 +51,11 @@ class RosAnchoringClient:
     def clear_expectation(self, symbol: str, source: str) -> None:
         self._expect(srv.ExpectAnchor.Request.CLEAR, symbol, (0.0, 0.0, 0.0), "", source)
 
+    def conclude_search(self, symbol: str, source: str) -> bool:
+        request = srv.ExpectAnchor.Request(symbol=symbol, expectation=srv.ExpectAnchor.Request.CONCLUDE_SEARCH,
+                                           source=source)
+        return bool(self._call(srv.ExpectAnchor, "expect_anchor", request).success)
+
     def _expect(
         self, expectation: int, symbol: str, position: Point, place: str, source: str, radius: float = 0.0
     ) -> None:

@@ -37,6 +37,7 @@ def anchor_report(message: AnchorMessage) -> AnchorReport:
         last_seen=stamp_to_seconds(message.last_seen),
         times_seen=int(message.times_seen),
         indistinguishable_from=tuple(str(symbol) for symbol in message.indistinguishable_from),
+        found_by_look_alone=str(message.found_by_look_alone),
     )
 
 

@@ -166,6 +166,11 @@ class Anchor:
     """While MISSING: the symbols of anchors that a search found and could not tell from this one
     (look-alikes, each as likely to be it); empty when its identity is decided. The finder reports
     it instead of guessing, so a planner learns "not found: cannot tell which" rather than a lie."""
+    found_by_look_alone: str = ""
+    """While MISSING: an anchor a search found that looks like this one where the camera had never
+    watched before it was seen (:class:`~.identity_repair.Unconfirmed`): a copy may have stood there
+    all along. Taken for this one only when the search concludes, having seen no other copy
+    (:meth:`~.anchoring.Anchoring.conclude_search`); empty: none."""
     parts_fit: np.ndarray | None = None
     """Where its box is the box around parts of it, joined (:mod:`.parts`), not a whole view's: the
     extent (:func:`turned_extent`) of the whole one of its class its parts were fit in, slack

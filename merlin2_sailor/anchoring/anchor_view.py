@@ -35,6 +35,7 @@ class AnchorView:
     last_seen: float
     """Its latest sighting that nothing since has put in doubt (:attr:`.Anchor.last_sure_sighting`)."""
     indistinguishable_from: tuple[str, ...] = ()
+    found_by_look_alone: str = ""
 
     @classmethod
     def of(cls, anchor: Anchor) -> AnchorView:
@@ -42,7 +43,7 @@ class AnchorView:
         position.flags.writeable = size.flags.writeable = False
         return cls(anchor.symbol, anchor.class_name, position, size, anchor.state, anchor.visible,
                    anchor.confidence, anchor.times_seen, anchor.last_tracker_id, anchor.first_seen,
-                   anchor.last_sure_sighting, anchor.indistinguishable_from)
+                   anchor.last_sure_sighting, anchor.indistinguishable_from, anchor.found_by_look_alone)
 
 
 def views_of(anchors: Iterable[Anchor]) -> list[AnchorView]:

@@ -39,7 +39,7 @@ from merlin2_sailor.anchoring.far_view import FarViewConfig, nearest_anchor, unr
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
 from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, register_frame, shift_percepts
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig
+from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig, Unconfirmed
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, sightings_doubled
 from merlin2_sailor.anchoring.match_explanation import matched_over
 from merlin2_sailor.anchoring.matcher import Matcher
@@ -354,6 +354,20 @@ class Anchoring:
             self._index.refresh(anchor)
         return changes.result()
 
+    def conclude_search(self, symbol: str, stamp: float | None = None) -> AnchoringResult:
+        """A search for ``symbol`` has looked everywhere: take the anchor it found by look alone
+        where the camera had never watched (``found_by_look_alone``) for it, unless a copy of it is
+        anchored by now (then AMBIGUOUS, naming them). The result holds the merge's events (none:
+        nothing was taken; the anchor says why in ``indistinguishable_from``, or had no candidate)."""
+        anchor = self._require(symbol)
+        when = self._latest_stamp if stamp is None else stamp
+        changes = FrameChanges(when if math.isfinite(when) else 0.0)
+        decision = self._repair.conclude_search(anchor, self._index)
+        apply_decision(decision, self._index, changes, self.config.fusion)
+        if changes.forgotten:
+            withdraw_stale_ambiguities(self._index)
+        return changes.result()
+
     def clear_expectation(self, symbol: str) -> None:
         """Drop an expectation that no longer applies (the carrying action ended, a search failed).
 
@@ -501,4 +515,6 @@ def _involved(decision: Decision | Duplicate | Return | None) -> tuple[Anchor, .
         return decision.kept, decision.duplicate
     if isinstance(decision, Return):
         return decision.anchor, decision.newcomer
+    if isinstance(decision, Unconfirmed):
+        return decision.sought, decision.found
     return ()

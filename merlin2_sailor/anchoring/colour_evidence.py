@@ -301,6 +301,30 @@ def colours_agree(first: ColourModel | None, second: ColourModel | None, config:
     return not colours_differ(first, second, config)
 
 
+def colours_agree_in_any_light(first: ColourModel | None, second: ColourModel | None,
+                               config: ColourEvidenceConfig) -> bool:
+    """:func:`colours_agree`, with the grey pixels' mid and light bins taken as one: whether two
+    anchors may be copies of one make lit differently. Light does not change a hue, but it moves the
+    grey pixels of a face between the mid and light bins (a face turned from the light is darker):
+    two red books of one make, one on a shelf and one on a desk turned another way, differed by
+    0.28, all of it mid grey gone light, and the desk's copy was no twin of the shelf's
+    (`removed_while_a_twin_is_unseen`, network, seed 0, 6 December 2026). What a copy is asked is
+    whether it could be the object, and that difference says nothing about it."""
+    return colours_agree(_lit_alike(first), _lit_alike(second), config)
+
+
+def _lit_alike(model: ColourModel | None) -> ColourModel | None:
+    """The model with its mid and light grey windows summed into the light one (the mid one empty);
+    their spreads are added, the larger of what their sum can vary by."""
+    if model is None:
+        return None
+    mid, light = HUE_BINS + 1, HUE_BINS + 2
+    mean, squares = model.mean.copy(), model.squares.copy()
+    mean[light], mean[mid] = mean[mid] + mean[light], 0.0
+    squares[light], squares[mid] = squares[mid] + squares[light], 0.0
+    return ColourModel(model.views, mean, squares)
+
+
 def colour_evidence_grew(model: ColourModel | None, minimum_views: int) -> bool:
     """Whether the latest view made the colour known (``minimum_views`` views) or doubled its views
     since (2, 4, 8... times as many): when an identity decided on colour is worth judging again."""

@@ -58,7 +58,12 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ, colours_agree
+from merlin2_sailor.anchoring.colour_evidence import (
+    ColourEvidenceConfig,
+    anchor_colours_differ,
+    colours_agree,
+    colours_agree_in_any_light,
+)
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.errors import ConfigurationError
@@ -148,7 +153,21 @@ class Undecided:
     reason: str
 
 
-Decision = Merge | Undecided
+@dataclass(frozen=True, slots=True, eq=False)
+class Unconfirmed:
+    """A search found ``found``, which looks like the MISSING ``sought``, where the camera had never
+    watched before it was seen, and the robot knows no twin of it: a copy may still have stood there
+    all along, and the look alone cannot tell (see :meth:`IdentityRepair.decide_search`). Nothing is
+    merged; the sought anchor records the candidate until the search concludes
+    (:meth:`IdentityRepair.conclude_search`) or another copy turns up (then :class:`Undecided`)."""
+
+    sought: Anchor
+    found: Anchor
+    score: float
+    reason: str
+
+
+Decision = Merge | Undecided | Unconfirmed
 
 
 class IdentityRepair:
@@ -194,8 +213,9 @@ class IdentityRepair:
         return self._unless_a_twin_stood_there(decision, index) if isinstance(decision, Merge) else decision
 
     def _unless_a_twin_stood_there(self, merge: Merge, index: AnchorIndex) -> Decision:
-        """The search's merge, or :class:`Undecided` when its candidate may be another look-alike of
-        the sought object that stood there all along.
+        """The search's merge; :class:`Undecided` when its candidate may be another look-alike of
+        the sought object that stood there all along; :class:`Unconfirmed` when only the look says
+        it is the sought one.
 
         A search finds an anchor that looks like the lost one, in the disc; it cannot know whether
         that is the lost object, moved there, or a look-alike of it that was always there. Where the
@@ -208,21 +228,55 @@ class IdentityRepair:
         its identical twin, was reported found as the identical blue book on the bedroom's
         nightstand, first seen after the shelf's was last seen and never watched before (probe
         scenario, network, seed 0, 5 December 2026; score 0.535).
+
+        Where the robot knows no twin, the look still does not single the lost object out: copies
+        of it may stand where the robot has not looked yet. So the candidate is only recorded
+        (:class:`Unconfirmed`) and the search looks on: a copy seen at a later stop is a twin, and
+        the case :class:`Undecided`; with none anywhere searched, the search concludes and takes it
+        (:meth:`conclude_search`). Measured: the red cookbook taken away, a red book of its make on
+        the living room's shelf, never looked into, was reported found as the cookbook, while a
+        third stood on the bedroom's desk (`removed_while_a_twin_is_unseen`, every seed).
         """
         if self.arrival_frames <= 0 or self._arrived(merge.merged):
             return merge
         lost, found = merge.kept, merge.merged
-        twins = [other.symbol for other in index.of_class(lost.class_name)
-                 if other is not lost and other is not found
-                 and other.state in (AnchorState.CONFIRMED, AnchorState.MISSING)
-                 and colours_agree(other.colour, lost.colour, self.colour)
-                 and self._anywhere(other, lost) >= self.match_threshold]
+        twins = self._twins(lost, index, besides=found)
         if not twins:
-            return merge
-        return Undecided((lost,), (found,), (merge.score,),
-                         f"{found.symbol} looks like {lost.symbol} but so does {', '.join(sorted(twins))}, and the "
-                         "camera had not watched where it stands before it was seen: it may be another twin that "
-                         "stood there all along")
+            return Unconfirmed(lost, found, merge.score,
+                               f"{found.symbol} looks like {lost.symbol}, where the camera had not watched before "
+                               "it was seen: a copy may have stood there all along")
+        named = [found, *(other for other in twins if other.symbol == lost.found_by_look_alone)]
+        return Undecided((lost,), tuple(named), (merge.score,),
+                         f"{found.symbol} looks like {lost.symbol} but so does "
+                         f"{', '.join(sorted(other.symbol for other in twins))}, and the camera had not watched "
+                         "where it stands before it was seen: it may be another twin that stood there all along")
+
+    def _twins(self, lost: Anchor, index: AnchorIndex, besides: Anchor) -> list[Anchor]:
+        """Other anchors (than ``lost`` and ``besides``) whose colour agrees with the lost one's, both
+        known, and that the matching function takes for it, place left out."""
+        return [other for other in index.of_class(lost.class_name)
+                if other is not lost and other is not besides
+                and other.state in (AnchorState.CONFIRMED, AnchorState.MISSING)
+                and colours_agree_in_any_light(other.colour, lost.colour, self.colour)
+                and self._anywhere(other, lost) >= self.match_threshold]
+
+    def conclude_search(self, sought: Anchor, index: AnchorIndex) -> Decision | None:
+        """A search that looked everywhere takes the candidate it found by look alone
+        (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
+        of it is anchored by now (:class:`Undecided`) or the candidate is gone or no longer
+        possible (None: nothing to take)."""
+        found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
+        if sought.state is not AnchorState.MISSING or found is None or sought.indistinguishable_from:
+            return None
+        if not self._possible(found, sought, include_missing=True):
+            return None
+        score = self._anywhere(found, sought)
+        twins = self._twins(sought, index, besides=found)
+        if twins:
+            return Undecided((sought,), (found, *twins), (score,),
+                             f"{found.symbol} looks like {sought.symbol} but so does "
+                             f"{', '.join(sorted(other.symbol for other in twins))}: it may be another copy")
+        return Merge(sought, found, score, "found by search; no other copy anywhere searched", moved=True)
 
     # --- reappearances ----------------------------------------------------------------------
 

@@ -16,7 +16,7 @@ from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.identity_repair import Decision, Merge
+from merlin2_sailor.anchoring.identity_repair import Decision, Merge, Unconfirmed
 from merlin2_sailor.anchoring.observation import drop_expectation
 from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS
 from merlin2_sailor.anchoring.parts import Parts, is_part
@@ -34,6 +34,8 @@ def withdraw_stale_ambiguities(index: AnchorIndex) -> None:
     for anchor in index.missing():
         if any(symbol not in index for symbol in anchor.indistinguishable_from):
             anchor.indistinguishable_from = ()
+        if anchor.found_by_look_alone and anchor.found_by_look_alone not in index:
+            anchor.found_by_look_alone = ""
 
 
 def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig) -> None:
@@ -118,10 +120,15 @@ def apply_decision(
         changes.event(AnchorEventKind.FORGOTTEN, duplicate.symbol,
                       reason=f"{decision.reason}: a second anchor of its object", **evidence)
         return
+    if isinstance(decision, Unconfirmed):
+        # Nothing merged, nothing said yet: the search looks on (see identity_repair).
+        decision.sought.found_by_look_alone = decision.found.symbol
+        return
     if not isinstance(decision, Merge):
         involved = [anchor.symbol for anchor in (*decision.lost, *decision.found)]
         for lost in decision.lost:
             others = tuple(symbol for symbol in involved if symbol != lost.symbol)
+            lost.found_by_look_alone = ""  # another copy turned up: the look alone decides nothing
             if others == lost.indistinguishable_from:
                 continue  # said already; a search re-decides each frame something new is confirmed
             lost.indistinguishable_from = others
@@ -139,6 +146,7 @@ def apply_decision(
     kept.visible = was_visible
     drop_expectation(kept)
     kept.indistinguishable_from = ()
+    kept.found_by_look_alone = ""
     # A merged anchor that is missing leaves the kept one missing, on its clock: the object
     # was last seen under that symbol, and seeing it again confirms it as usual.
     kept.state = AnchorState.MISSING if still_missing else AnchorState.CONFIRMED

@@ -30,7 +30,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
-from merlin2_sailor.anchoring.anchor import AnchorState
+from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_view import AnchorView
 from merlin2_sailor.anchoring.anchoring import AnchoringResult
 from merlin2_sailor.anchoring.events import AnchorEventKind
@@ -372,7 +372,7 @@ class AnchoringNode(Node):
     def _expect_anchor(self, request: srv.ExpectAnchor.Request, response: srv.ExpectAnchor.Response) -> Any:
         now = self.get_clock().now().nanoseconds * 1e-9
         position = np.array([request.position.x, request.position.y, request.position.z])
-        result = None
+        result, refusal = None, ""
         try:
             with self._lock:
                 if request.symbol not in self._anchoring:
@@ -385,17 +385,30 @@ class AnchoringNode(Node):
                         now, offset=position, source=request.source), robot_pose=self._robot_pose)
                 elif request.expectation == request.CLEAR:
                     self._anchoring.clear_expectation(request.symbol)
+                elif request.expectation == request.CONCLUDE_SEARCH:
+                    result = self._anchoring.conclude_search(request.symbol)
+                    refusal = _not_concluded(self._anchoring.get(request.symbol))
                 else:
                     raise ConfigurationError(f"unknown expectation {request.expectation}")
         except SailorError as error:
             response.message = str(error)
             return response
-        response.success = True
+        response.success = not refusal
+        response.message = refusal
         if result is not None and result.events:
             self._publish(result)  # a search that found its object under a newer anchor: the merge
         else:
             self._publish_state()
         return response
+
+
+def _not_concluded(anchor: Anchor | None) -> str:
+    """Why a concluded search took nothing for ``anchor`` (empty: it took its candidate)."""
+    if anchor is None or anchor.state is not AnchorState.MISSING:
+        return ""
+    if anchor.indistinguishable_from:
+        return f"{anchor.symbol} cannot be told from {', '.join(anchor.indistinguishable_from)} (they look alike)"
+    return f"{anchor.symbol} has no candidate a search found by its look alone"
 
 
 def main(argv: Sequence[str] | None = None) -> int:

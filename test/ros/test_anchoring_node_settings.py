@@ -104,10 +104,12 @@ def test_every_setting_is_declared_with_its_descriptor_and_a_bad_one_is_refused_
 def test_views_convert_to_the_messages_their_anchors_convert_to() -> None:
     anchor = Anchor(symbol="cup_1", class_name="cup", position=np.array([1.0, 2.0, 0.8]),
                     size=np.array([0.1, 0.1, 0.12]), first_seen=3.0, last_seen=4.5, state=AnchorState.MISSING,
-                    times_seen=7, last_tracker_id="12", indistinguishable_from=("cup_4",))
+                    times_seen=7, last_tracker_id="12", indistinguishable_from=("cup_4",),
+                    found_by_look_alone="cup_9")
     header = Header(frame_id="map")
     view = AnchorView.of(anchor)
     assert anchors_to_message([view], header) == anchors_to_message([anchor], header)
+    assert anchors_to_message([view], header).anchors[0].found_by_look_alone == "cup_9"
     assert anchor_markers([view], header) == anchor_markers([anchor], header)
     anchor.position[0] = 9.0  # the view is a copy: its message does not move with the anchor
     assert anchors_to_message([view], header).anchors[0].position.x == 1.0

@@ -52,6 +52,7 @@ def anchor_to_message(anchor: AnchorLike) -> AnchorMessage:
         confidence=float(anchor.confidence), times_seen=int(anchor.times_seen),
         last_tracker_id=anchor.last_tracker_id,
         indistinguishable_from=list(anchor.indistinguishable_from),
+        found_by_look_alone=anchor.found_by_look_alone,
         first_seen=seconds_to_stamp(anchor.first_seen), last_seen=seconds_to_stamp(anchor.last_seen),
     )
     message.position.x, message.position.y, message.position.z = (float(v) for v in anchor.position)

@@ -9,6 +9,12 @@ Situations: a look-alike moved while its twin stays; an object removed while ano
 class, another colour, is seen in the searched room; two look-alikes found for one lost mug;
 two lost look-alikes and one found; a newcomer of another look beside a missing anchor; a
 search that goes on while the object is anchored anew.
+
+The searched rooms here were never watched before their mugs were seen, and no twin of a lost mug
+is known by its colour: a search that finds its mug only records the find by look alone
+(``found_by_look_alone``; the lost anchor stays MISSING) and takes it when it concludes, having
+looked everywhere (``Anchoring.conclude_search``). A candidate the search rules out is neither
+recorded nor taken then.
 """
 
 from __future__ import annotations
@@ -69,6 +75,17 @@ def kinds(result):
     return [(event.kind, event.symbol) for event in result.events]
 
 
+def recorded(anchoring, symbol):
+    """The sought anchor's state and the candidate its search found by look alone ("": none)."""
+    sought = anchoring.get(symbol)
+    return sought.state, sought.found_by_look_alone
+
+
+def concluded(anchoring, symbol):
+    """The search for ``symbol`` has looked everywhere: what concluding it does, as (kind, symbol)."""
+    return kinds(anchoring.conclude_search(symbol))
+
+
 @pytest.mark.parametrize("turning_frames", [6, 8, 11])
 def test_a_search_judges_a_newcomer_again_as_its_views_grow(anchoring, maker, turning_frames):
     """The moved mug is first seen in the searched room from its other side, which does not look
@@ -76,12 +93,13 @@ def test_a_search_judges_a_newcomer_again_as_its_views_grow(anchoring, maker, tu
     search cannot take its new anchor when it is confirmed, but its later views look like the lost
     mug, and the search, judging it again as its sightings double, finds it (test_merlin2_mission,
     network, 5 December 2026: judged only once, the search gave up on a newcomer that its later
-    views showed to be the red mug)."""
+    views showed to be the red mug). The living room was never watched: the find is recorded when
+    a later judgement makes it, and taken when the search concludes."""
     seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
     see(anchoring, maker, [], 1.0)
     assert search_living_room(anchoring, "cup_1", 1.5).events == ()
     other_side, own_side = maker.appearance("the blue mug's other side"), maker.appearance("blue_mug")
-    found = None
+    found_at = None
     for frame in range(2 * turning_frames + 4):
         stamp = WALKED_THERE + frame * FRAME
         turned = min(frame / turning_frames, 1.0)
@@ -89,10 +107,17 @@ def test_a_search_judges_a_newcomer_again_as_its_views_grow(anchoring, maker, tu
         percept = dataclasses.replace(maker.percept(KITCHEN_MUG, stamp, position=(1.5, 7.2, 0.8)),
                                       embedding=(look / np.linalg.norm(look)).astype(np.float32))
         result = anchoring.process([percept], None, stamp)
-        found = found or next((e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN), None)
+        assert not [e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN], "merged before concluding"
+        if found_at is None and anchoring.get("cup_1").found_by_look_alone:
+            found_at = frame
         if frame == 1:
-            assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and found is None, "taken at once"
-    assert found is not None and found.symbol == "cup_2" and found.details["reason"].endswith("it is cup_1")
+            assert anchoring.get("cup_2").state is AnchorState.CONFIRMED, "not confirmed yet"
+            assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, ""), "found at once"
+    assert found_at is not None and found_at > 1, "never judged again"
+    assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "cup_2")
+    result = anchoring.conclude_search("cup_1")
+    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
+    assert result.events[0].details["reason"].endswith("it is cup_1")
     assert anchoring.get("cup_1").state is AnchorState.CONFIRMED and len(anchoring) == 1
 
 
@@ -102,8 +127,9 @@ def test_a_look_alike_moved_while_its_twin_stays_is_found_under_its_own_symbol(a
     see(anchoring, maker, [TWIN], 1.0)  # the kitchen: the twin is there, the other mug is not
     assert anchoring.get(mug).state is AnchorState.MISSING
     seen_twice(anchoring, maker, [KITCHEN_MUG], WALKED_THERE, camera=False, positions={"blue_mug": LIVING_ROOM})
-    result = search_living_room(anchoring, mug, WALKED_THERE + 1.0)
-    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, mug)]
+    assert search_living_room(anchoring, mug, WALKED_THERE + 1.0).events == ()
+    assert recorded(anchoring, mug) == (AnchorState.MISSING, "cup_3")
+    assert concluded(anchoring, mug) == [(AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, mug)]
     np.testing.assert_allclose(anchoring.get(mug).position, LIVING_ROOM, atol=0.05)
     assert anchoring.get(twin).state is AnchorState.CONFIRMED  # the twin keeps its own symbol
 
@@ -114,6 +140,8 @@ def test_a_removed_object_is_never_reported_found_as_another_of_its_class(anchor
     seen_twice(anchoring, maker, [GREEN_MUG], WALKED_THERE, camera=False)  # a green mug, in the searched room
     result = search_living_room(anchoring, "cup_1", WALKED_THERE + 1.0)
     assert result.events == ()
+    assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "")  # not even found by look alone
+    assert concluded(anchoring, "cup_1") == []  # so concluding the search takes nothing
     assert anchoring.get("cup_1").state is AnchorState.MISSING
     assert anchoring.get("cup_2").state is AnchorState.CONFIRMED
     # The rules alone cannot tell the two apart: they take the green mug for the lost one.
@@ -121,7 +149,9 @@ def test_a_removed_object_is_never_reported_found_as_another_of_its_class(anchor
     seen_twice(rules, maker, [KITCHEN_MUG], 0.0)
     see(rules, maker, [], 1.0)
     seen_twice(rules, maker, [GREEN_MUG], WALKED_THERE, camera=False)
-    assert kinds(search_living_room(rules, "cup_1", WALKED_THERE + 1.0))[0] == (AnchorEventKind.FORGOTTEN, "cup_2")
+    assert search_living_room(rules, "cup_1", WALKED_THERE + 1.0).events == ()
+    assert recorded(rules, "cup_1") == (AnchorState.MISSING, "cup_2")
+    assert concluded(rules, "cup_1")[0] == (AnchorEventKind.FORGOTTEN, "cup_2")
 
 
 def test_two_look_alikes_found_for_one_lost_mug_are_reported_not_guessed(anchoring, maker):
@@ -164,21 +194,26 @@ def test_a_newcomer_of_another_look_beside_a_missing_anchor_is_not_it(anchoring,
 def test_a_search_under_way_recognises_the_object_when_it_is_anchored_anew(anchoring, maker):
     """The search was announced before the moved mug was seen: it was anchored anew (the camera
     saw it from afar, outside the searched disc's reach of the matching gate); the confirmation
-    itself brings it into question, and the search finds it."""
+    itself brings it into question, and the search finds it: recorded at once (the camera had not
+    watched there), taken when the search concludes."""
     seen_twice(anchoring, maker, [KITCHEN_MUG, GREEN_MUG], 0.0)
     mug, green = symbol_at(anchoring, KITCHEN_MUG), symbol_at(anchoring, GREEN_MUG)
     see(anchoring, maker, [GREEN_MUG], 1.0)
     assert anchoring.get(mug).state is AnchorState.MISSING
     assert search_living_room(anchoring, mug, 1.5).events == ()  # nothing new yet: the green one is older
     moved = np.array((1.5, 8.0, 0.8))  # 2 m from the centre: beyond the disc, within its tolerance
-    found = None
     for frame in range(2):
         # 6 s: late enough to have been carried 7.7 m (carry_speed), early enough for the matching
         # gate, which widens while an anchor is unseen, not to reach it from the disc.
         result = see(anchoring, maker, [KITCHEN_MUG], 6.0 + frame * FRAME, camera=False,
                      positions={"blue_mug": moved})
-        found = found or next((e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN), None)
-    assert found is not None and found.details["reason"].endswith(f"it is {mug}")
+        assert not [e for e in result.events if e.kind is AnchorEventKind.FORGOTTEN], "merged before concluding"
+    newcomer = min(anchoring.anchors, key=lambda anchor: np.linalg.norm(anchor.position - moved)).symbol
+    assert newcomer not in (mug, green) and anchoring.get(newcomer).state is AnchorState.CONFIRMED
+    assert recorded(anchoring, mug) == (AnchorState.MISSING, newcomer)
+    result = anchoring.conclude_search(mug)
+    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, newcomer), (AnchorEventKind.CONFIRMED, mug)]
+    assert result.events[0].details["reason"].endswith(f"it is {mug}")
     cup = anchoring.get(mug)
     assert cup.state is AnchorState.CONFIRMED and cup.expectation is None
     np.testing.assert_allclose(cup.position, moved, atol=0.05)
@@ -273,7 +308,9 @@ def test_a_look_alike_seen_too_soon_too_far_away_is_not_the_lost_object(maker, m
     """A search takes a newcomer that looks the same for the lost object only if someone could have
     carried it there in the time between the lost anchor's last sighting and the newcomer's first
     (probe scenario, network, seed 0, 5 December 2026: a television taken out of the house was
-    reported found as the bedroom's, of one make, first seen 5.5 m away 0.73 s later)."""
+    reported found as the bedroom's, of one make, first seen 5.5 m away 0.73 s later). The bedroom
+    was never watched: a newcomer that could have been carried there is recorded as found by look
+    alone and taken when the search concludes; one that could not is neither."""
     from merlin2_sailor.anchoring.identity_repair import RepairConfig
     lost_place = np.array(KITCHEN_MUG.position)
     elsewhere = lost_place + (0.0, metres, 0.0)
@@ -290,11 +327,14 @@ def test_a_look_alike_seen_too_soon_too_far_away_is_not_the_lost_object(maker, m
         seen_twice(anchoring, maker, [look_alike], last_sighting + seconds, camera=False)
         assert anchoring.get("cup_2").state is AnchorState.CONFIRMED
         disc = Expectation.at(elsewhere, last_sighting + seconds + 1.0, "bedroom", "find", radius=1.0)
-        return kinds(anchoring.expect("cup_1", disc))
+        searched = kinds(anchoring.expect("cup_1", disc))
+        return searched, recorded(anchoring, "cup_1"), concluded(anchoring, "cup_1")
 
     merged = [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
-    assert search_after(RepairConfig().carry_speed) == (merged if carried else [])
-    assert search_after(0.0) == merged  # without the bound, the look decides alone: the failure fixed
+    taken = ([], (AnchorState.MISSING, "cup_2"), merged)  # recorded by the search, taken when it concludes
+    nothing = ([], (AnchorState.MISSING, ""), [])
+    assert search_after(RepairConfig().carry_speed) == (taken if carried else nothing)
+    assert search_after(0.0) == taken  # without the bound, the look decides alone: the failure fixed
 
 
 @pytest.mark.parametrize("value", [-0.5, float("nan"), float("inf")])
@@ -389,7 +429,8 @@ def test_a_tentative_anchor_confirmed_long_after_its_first_sighting_may_be_the_l
     """A glimpse of a mug in the living room leaves a tentative anchor while the blue mug is still in
     the kitchen; a minute later the blue mug, moved there, confirms that anchor. Born again with its
     count, it may be the blue mug (`moved_while_its_twin_is_watched`, network, seed 2, 5 December
-    2026: it could not, and the search gave up)."""
+    2026: it could not, and the search gave up): the search records it, and takes it when it
+    concludes."""
     seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
     glimpse = SceneObject("glimpse", "cup", tuple(LIVING_ROOM), looks_like="blue_mug")
     see(anchoring, maker, [KITCHEN_MUG, glimpse], 2 * FRAME, camera=False)
@@ -399,8 +440,9 @@ def test_a_tentative_anchor_confirmed_long_after_its_first_sighting_may_be_the_l
     assert anchoring.get("cup_1").state is AnchorState.MISSING
     seen_twice(anchoring, maker, [KITCHEN_MUG], 60.0, camera=False, positions={"blue_mug": LIVING_ROOM})
     assert anchoring.get("cup_2").state is AnchorState.CONFIRMED and anchoring.get("cup_2").first_seen == 60.0
-    result = search_living_room(anchoring, "cup_1", 61.0)
-    assert kinds(result) == [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
+    assert search_living_room(anchoring, "cup_1", 61.0).events == ()
+    assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "cup_2")
+    assert concluded(anchoring, "cup_1") == [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")]
 
 
 def test_a_search_for_an_anchor_perception_has_confirmed_leaves_it_where_it_was_seen(anchoring, maker):

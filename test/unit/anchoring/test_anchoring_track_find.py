@@ -260,6 +260,14 @@ def lose(anchoring, stamp):
     anchoring.process([], camera_view(), stamp)
 
 
+def recorded(anchoring, symbol):
+    """The sought anchor's state and the candidate its search found by look alone ("": none): where
+    the camera had never watched before a candidate was seen, a search only records it, and takes it
+    when it concludes (``Anchoring.conclude_search``)."""
+    sought = anchoring.get(symbol)
+    return sought.state, sought.found_by_look_alone
+
+
 def test_a_missing_object_moved_elsewhere_is_reacquired_by_a_search(make_anchoring, maker, kitchen):
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
@@ -352,8 +360,9 @@ def test_only_a_place_can_be_searched():
 
 def test_a_search_finds_the_object_anchored_anew_while_it_was_missing(make_anchoring, maker, kitchen):
     """Moved while the robot was elsewhere and seen from afar 3 s later (time enough to carry it
-    4 m), the mug got a new anchor; the search for the missing one recognises it and the mug keeps
-    its first symbol."""
+    4 m), the mug got a new anchor; the search for the missing one recognises it (where the camera
+    had never watched: it records the find, and takes it when it concludes) and the mug keeps its
+    first symbol."""
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
     seen_twice(anchoring, maker, [cup])
@@ -362,7 +371,11 @@ def test_a_search_finds_the_object_anchored_anew_while_it_was_missing(make_ancho
     for frame in range(2):
         anchoring.process([maker.percept(cup, 4.0 + frame * FRAME, position=elsewhere)], None, 4.0 + frame * FRAME)
     assert {a.symbol for a in anchoring.anchors} == {"cup_1", "cup_2"}
-    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 5.0, "bedroom", "find", radius=2.5))
+    searched = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 5.0, "bedroom", "find",
+                                                        radius=2.5))
+    assert searched.events == () and {a.symbol for a in anchoring.anchors} == {"cup_1", "cup_2"}
+    assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "cup_2")
+    result = anchoring.conclude_search("cup_1")
     assert {a.symbol for a in anchoring.anchors} == {"cup_1"}
     kept = anchoring.get("cup_1")
     assert kept.state is AnchorState.CONFIRMED and kept.expectation is None and kept.missing_since is None
@@ -378,8 +391,9 @@ def test_a_search_finds_the_object_anchored_anew_while_it_was_missing(make_ancho
 
 def test_a_search_finds_the_newcomer_even_once_it_has_gone_missing_again(make_anchoring, maker, kitchen):
     """Seen from a doorway and anchored anew, then missed for a few frames before the search came
-    there: still the sought object. The first symbol takes its place and stays missing until the
-    mug is seen again, which brings it back under that symbol."""
+    there: still the sought object (recorded by the search, taken when it concludes). The first
+    symbol takes its place and stays missing until the mug is seen again, which brings it back under
+    that symbol."""
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
     seen_twice(anchoring, maker, [cup])
@@ -393,7 +407,11 @@ def test_a_search_finds_the_newcomer_even_once_it_has_gone_missing_again(make_an
         anchoring.process([], towards, 4.5 + frame * FRAME)  # the detector misses it
         frame += 1
     assert anchoring.get("cup_2").state is AnchorState.MISSING
-    result = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 5.0, "bedroom", "find", radius=2.5))
+    searched = anchoring.expect("cup_1", Expectation.at(elsewhere + (1.0, 0.5, 0.0), 5.0, "bedroom", "find",
+                                                        radius=2.5))
+    assert searched.events == () and {a.symbol for a in anchoring.anchors} == {"cup_1", "cup_2"}
+    assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "cup_2")
+    result = anchoring.conclude_search("cup_1")
     assert {a.symbol for a in anchoring.anchors} == {"cup_1"}
     assert [(e.kind, e.symbol) for e in result.events] == [(AnchorEventKind.FORGOTTEN, "cup_2")]
     kept = anchoring.get("cup_1")
@@ -422,9 +440,11 @@ def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_e
 ):
     """Moved, and seen in the living room beside another mug, before the robot found its old
     place empty: the newcomer is older than the missing anchor's loss, but younger than its last
-    sighting. If the other mug was first seen after that sighting too (and late enough to have
-    been carried there: RepairConfig.carry_speed), nothing tells the two apart without
-    appearance: the search merges neither, and says so, naming both."""
+    sighting. If the other mug was first seen before that sighting, only the newcomer can be it:
+    the living room never watched, the search records it and takes it when it concludes. If the
+    other mug was first seen after that sighting too (and late enough to have been carried there:
+    RepairConfig.carry_speed), nothing tells the two apart without appearance: the search merges
+    neither, and says so, naming both; nor does concluding it take either."""
     anchoring = make_anchoring()
     cup = kitchen["red_cup"]
     other_mug = SceneObject("green_mug", "cup", (1.1, 5.3, 0.8))
@@ -445,6 +465,9 @@ def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_e
     result = anchoring.expect("cup_1", Expectation.at((1.5, 5.75, 0.8), moved_seen + 1.5, "living_room", "find",
                                                       radius=1.0))
     if seen_after_the_other_mug:
+        assert result.events == () and len(anchoring) == 3
+        assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "cup_3")
+        result = anchoring.conclude_search("cup_1")
         assert [(e.kind, e.symbol) for e in result.events] == [
             (AnchorEventKind.FORGOTTEN, "cup_3"), (AnchorEventKind.CONFIRMED, "cup_1")]
         assert {a.symbol for a in anchoring.anchors} == {"cup_1", "cup_2"}
@@ -454,4 +477,7 @@ def test_a_search_finds_the_object_anchored_anew_before_its_old_place_was_seen_e
         assert [(e.kind, e.symbol, e.details["candidates"]) for e in result.events] == [
             (AnchorEventKind.AMBIGUOUS, "cup_1", "cup_2,cup_3")]
         assert len(anchoring) == 3 and anchoring.get("cup_1").state is AnchorState.MISSING
+        assert anchoring.get("cup_1").indistinguishable_from == ("cup_2", "cup_3")
+        assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, "")
+        assert anchoring.conclude_search("cup_1").events == () and len(anchoring) == 3
         assert anchoring.get("cup_1").indistinguishable_from == ("cup_2", "cup_3")

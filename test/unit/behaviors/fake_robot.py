@@ -107,6 +107,8 @@ class FakeAnchoring:
     anchors: dict[str, AnchorReport] = field(default_factory=dict)
     expectations: list[Expectation] = field(default_factory=list)
     down: bool = False
+    refuse_conclusions: bool = False
+    """conclude_search answers False whatever the reports say (the anchoring layer did not take it)."""
     _clock: itertools.count = field(default_factory=lambda: itertools.count(100))
 
     def add(self, symbol: str, class_name: str, position: tuple[float, float, float],
@@ -121,6 +123,17 @@ class FakeAnchoring:
         self.anchors[symbol] = replace(
             report, state=AnchorState.CONFIRMED, last_seen=float(next(self._clock)),
             position=position or report.position, times_seen=report.times_seen + 1)
+
+    def report(self, symbol: str, found_by_look_alone: str | None = None,
+               indistinguishable_from: tuple[str, ...] | None = None) -> None:
+        """Set what the anchoring layer reports about a missing anchor's search (None: unchanged)."""
+        report = self.anchors[symbol]
+        self.anchors[symbol] = replace(
+            report,
+            found_by_look_alone=report.found_by_look_alone if found_by_look_alone is None else found_by_look_alone,
+            indistinguishable_from=(
+                report.indistinguishable_from if indistinguishable_from is None else indistinguishable_from),
+        )
 
     def _check(self) -> None:
         if self.down:
@@ -159,6 +172,20 @@ class FakeAnchoring:
     def clear_expectation(self, symbol: str, source: str) -> None:
         self._check()
         self.expectations.append(Expectation("clear", symbol, (0.0, 0.0, 0.0), "", source))
+
+    def conclude_search(self, symbol: str, source: str) -> bool:
+        """Like the real one: the candidate found by look alone becomes the sought anchor (confirmed
+        where the candidate is, seen now; the candidate's report is gone), unless a copy turned up."""
+        self._check()
+        self.expectations.append(Expectation("conclude", symbol, (0.0, 0.0, 0.0), "", source))
+        sought = self.anchors.get(symbol)
+        if (self.refuse_conclusions or sought is None or sought.indistinguishable_from
+                or sought.found_by_look_alone not in self.anchors):
+            return False
+        candidate = self.anchors.pop(sought.found_by_look_alone)
+        self.anchors[symbol] = replace(sought, found_by_look_alone="")
+        self.see(symbol, candidate.position)
+        return True
 
 
 @dataclass

@@ -229,3 +229,123 @@ def test_find_that_sees_the_object_on_the_way_goes_to_it_and_moves_no_anchor(rob
     assert to_c.yaw == pytest.approx(math.atan2(0.5 - WAYPOINTS["c"][1], 5.1 - WAYPOINTS["c"][0]))  # facing it
     assert [e.kind for e in robot.anchoring.expectations] == []  # it was seen: nothing announced
     assert robot.anchoring.anchors["cup_1"].position[:2] == (5.1, 0.5)
+
+
+TOUR = ["b", "a", "d", "c"]
+"""The stops a search for cup_1 (last anchored near b) visits, in order, starting from a."""
+
+CANDIDATE_OFFSET = (0.3, 0.4)
+"""Where the look-alike found by look alone stands, from its stop's waypoint."""
+
+
+def found_by_look_alone_at(robot: FakeRobot, stop: str, candidate: str = "cup_4") -> tuple[float, float, float]:
+    """On the first arrival at ``stop``, the search there finds ``candidate``, which looks like
+    cup_1, where the camera had never watched: the anchoring layer reports it, and merges nothing."""
+    x, y = WAYPOINTS[stop]
+    position = (x + CANDIDATE_OFFSET[0], y + CANDIDATE_OFFSET[1], 0.8)
+    done: list[bool] = []
+
+    def find_look_alike(pose: Pose2D) -> None:
+        if not done and (pose.x, pose.y) == (x, y):
+            done.append(True)
+            robot.anchoring.add(candidate, "cup", position)
+            robot.anchoring.report("cup_1", found_by_look_alone=candidate)
+
+    robot.navigation.on_arrival.insert(0, find_look_alike)
+    return position
+
+
+def copy_turns_up_at(robot: FakeRobot, stop: str, copies: tuple[str, ...] = ("cup_4", "cup_5")) -> None:
+    """On arrival at ``stop``, another copy is seen: the anchoring layer cannot tell cup_1 from them."""
+
+    def see_copy(pose: Pose2D) -> None:
+        if (pose.x, pose.y) == WAYPOINTS[stop]:
+            robot.anchoring.report("cup_1", indistinguishable_from=copies)
+
+    robot.navigation.on_arrival.insert(0, see_copy)
+
+
+@pytest.mark.parametrize("stop", TOUR)
+def test_find_that_finds_it_by_look_alone_searches_every_other_stop_then_takes_it_there(
+    robot: FakeRobot, stop: str,
+) -> None:
+    """A look-alike found where the camera had never watched may be a copy that stood there all
+    along: the search looks at every remaining stop, and only then, no copy seen, goes back to it,
+    concludes and ends there."""
+    position = found_by_look_alone_at(robot, stop)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == SUCCEED, blackboard
+    assert stops(robot) == (TOUR if TOUR[-1] == stop else [*TOUR, stop])  # every stop, then back to it
+    kinds = [e.kind for e in robot.anchoring.expectations]
+    assert kinds.count("at") == len(TOUR) and kinds[-1] == "conclude"  # concluded after every stop
+    concluded = robot.anchoring.expectations[-1]
+    assert (concluded.symbol, concluded.source) == ("cup_1", FIND_SOURCE)
+    last = robot.navigation.goals[-1]
+    assert (last.x, last.y) == WAYPOINTS[stop]
+    assert last.yaw == pytest.approx(math.atan2(CANDIDATE_OFFSET[1], CANDIDATE_OFFSET[0]))  # facing it
+    assert blackboard[FOUND_SYMBOL_KEY] == "cup_1" and blackboard[FOUND_AT_KEY] == stop
+    assert robot_locations(robot.store) == (stop,)
+    assert robot.anchoring.anchors["cup_1"].position == position and "cup_4" not in robot.anchoring.anchors
+    noted = [message for _, message in robot.logs if "cup_1 looks like cup_4" in message]
+    assert len(noted) == 1 and f"at {stop}" in noted[0] and "a copy may have stood there" in noted[0]
+
+
+@pytest.mark.parametrize(("found_at", "copy_at"), [("b", "d"), ("b", "c"), ("a", "c")])
+def test_find_that_sees_a_copy_after_a_look_alone_find_ends_unable_to_tell_and_never_concludes(
+    robot: FakeRobot, found_at: str, copy_at: str,
+) -> None:
+    found_by_look_alone_at(robot, found_at)
+    copy_turns_up_at(robot, copy_at)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT
+    assert blackboard[REASON_KEY] == "cup_1 cannot be told from cup_4, cup_5 (they look alike): its identity is unknown"
+    searched = TOUR[:TOUR.index(copy_at) + 1]
+    assert stops(robot) == [*searched, "a"]  # ends where the copy turned up, then back to its origin
+    assert "conclude" not in [e.kind for e in robot.anchoring.expectations]
+    assert FOUND_SYMBOL_KEY not in blackboard
+    assert any("cup_1 looks like cup_4" in message for _, message in robot.logs)  # it went on past the find
+
+
+def test_find_whose_conclusion_is_refused_ends_not_found_back_at_its_origin(robot: FakeRobot) -> None:
+    found_by_look_alone_at(robot, "b")
+    robot.anchoring.refuse_conclusions = True
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT
+    assert blackboard[REASON_KEY] == "cup_1 was not found at b, a, d, c"
+    assert stops(robot) == [*TOUR, "b", "a"]  # back to the candidate, then to its origin
+    assert [e.kind for e in robot.anchoring.expectations][-1] == "conclude"
+    assert FOUND_SYMBOL_KEY not in blackboard and robot_locations(robot.store) == ("a",)
+    assert any("not taken for cup_1" in message for _, message in robot.logs)
+
+
+def test_find_whose_conclusion_meets_a_copy_ends_unable_to_tell(robot: FakeRobot) -> None:
+    """A copy anchored meanwhile (the anchoring layer refuses the conclusion and reports the
+    look-alikes): the search gives up saying it cannot tell them apart."""
+    found_by_look_alone_at(robot, "d")
+    conclude_search = robot.anchoring.conclude_search
+
+    def copy_then_conclude(symbol: str, source: str) -> bool:
+        robot.anchoring.report("cup_1", indistinguishable_from=("cup_4", "cup_9"))
+        return conclude_search(symbol, source)
+
+    robot.anchoring.conclude_search = copy_then_conclude  # type: ignore[method-assign]
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT
+    assert blackboard[REASON_KEY] == "cup_1 cannot be told from cup_4, cup_9 (they look alike): its identity is unknown"
+    assert stops(robot) == [*TOUR, "d", "a"]
+    assert FOUND_SYMBOL_KEY not in blackboard
+
+
+def test_find_that_cannot_reach_the_candidate_again_ends_not_found(robot: FakeRobot) -> None:
+    found_by_look_alone_at(robot, "b")
+
+    def b_blocked_after_the_tour(pose: Pose2D) -> None:
+        if (pose.x, pose.y) == WAYPOINTS["c"]:
+            robot.navigation.unreachable.add(WAYPOINTS["b"])
+
+    robot.navigation.on_arrival.append(b_blocked_after_the_tour)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT and blackboard[REASON_KEY] == "cup_1 was not found at b, a, d, c"
+    assert stops(robot) == [*TOUR, "b", "a"]  # tried b (no path), then back to its origin
+    assert any("could not reach b" in warning for warning in blackboard[WARNINGS_KEY])
+    assert "conclude" not in [e.kind for e in robot.anchoring.expectations]
