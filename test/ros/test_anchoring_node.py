@@ -17,11 +17,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import Point, PoseStamped
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import CameraInfo
 from std_msgs.msg import Header
 
+from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 from merlin2_sailor.ros.conversions import camera_info_message, percepts_to_message, seconds_to_stamp
 from merlin2_sailor.ros.qos import EVENTS, LATCHED, SENSOR_DATA
@@ -285,3 +286,54 @@ def test_the_camera_pose_from_tf_judges_what_is_in_view(tmp_path, upstream_stack
     assert anchoring.stop() == 0
     assert "no transform from 'camera_color_optical_frame' to 'map'" in anchoring.text, anchoring.text
     assert "Traceback" not in anchoring.text
+
+
+def test_a_search_concludes_on_a_find_by_look_alone_over_dds(tmp_path, ros_probe, node_process) -> None:
+    """The cup goes missing in front of the camera; a cup of its look appears behind it, where the
+    camera never watched: a search there records it (the Anchor message's found_by_look_alone) and
+    merges nothing; CONCLUDE_SEARCH takes it, and the cup is found under its own symbol."""
+    anchoring = node_process("anchoring", "--ros-args", "-p", "knowledge_base:=''", "-p", f"state_folder:={tmp_path}")
+    assert ros_probe.wait_for_node("/anchoring"), anchoring.text
+    camera = PerceptionStandIn(ros_probe)
+    time.sleep(1.0)  # discovery between the stand-in's publishers and the node
+    for _ in range(4):
+        camera.frame([CUP])
+    assert "cup_1" in anchors_once(ros_probe, lambda seen: "cup_1" in seen), anchoring.text
+
+    def expect(expectation: int, **fields) -> srv.ExpectAnchor.Response:
+        request = srv.ExpectAnchor.Request(symbol="cup_1", expectation=expectation, source="find_object", **fields)
+        return call(ros_probe, srv.ExpectAnchor, "/anchoring/expect_anchor", request)
+
+    behind = ("cup", np.array([-3.0, 0.5, 0.8]))  # behind the camera: never watched
+    # Gone from in front of the camera; then, after long enough for someone to carry it 6.5 m
+    # (carry_speed), seen behind it.
+    gone = anchors_once(ros_probe, lambda seen: seen["cup_1"].state == Anchor.STATE_MISSING, timeout=0.0)
+    deadline = time.monotonic() + 30.0
+    while time.monotonic() < deadline and gone["cup_1"].state != Anchor.STATE_MISSING:
+        camera.frame([])
+        gone = latest_anchors(ros_probe, timeout=2.0)
+    carried = time.monotonic() + 6.5 / RepairConfig().carry_speed + 0.5
+    anchors = gone
+    while time.monotonic() < deadline and not (
+            anchors.get("cup_2") is not None and anchors["cup_2"].state == Anchor.STATE_CONFIRMED):
+        camera.frame([behind] if time.monotonic() > carried else [])
+        anchors = latest_anchors(ros_probe, timeout=2.0)
+    assert anchors["cup_1"].state == Anchor.STATE_MISSING and anchors["cup_2"].state == Anchor.STATE_CONFIRMED, (
+        sorted(anchors), anchoring.text)
+    refused = expect(srv.ExpectAnchor.Request.CONCLUDE_SEARCH)
+    assert not refused.success and "no candidate" in refused.message
+
+    search = expect(srv.ExpectAnchor.Request.EXPECT_AT, position=Point(x=-3.0, y=0.0, z=0.8), place="living_room",
+                    radius=1.5)
+    assert search.success, search.message
+    recorded = anchors_once(ros_probe, lambda seen: seen["cup_1"].found_by_look_alone == "cup_2")
+    assert recorded["cup_1"].found_by_look_alone == "cup_2" and recorded["cup_1"].state == Anchor.STATE_MISSING
+    assert "cup_2" in recorded  # nothing merged yet
+
+    concluded = expect(srv.ExpectAnchor.Request.CONCLUDE_SEARCH)
+    assert concluded.success, concluded.message
+    found = anchors_once(ros_probe, lambda seen: "cup_2" not in seen)
+    assert sorted(found) == ["cup_1"] and found["cup_1"].state == Anchor.STATE_CONFIRMED, anchoring.text
+    np.testing.assert_allclose([found["cup_1"].position.x, found["cup_1"].position.y], [-3.0, 0.5], atol=0.1)
+    assert found["cup_1"].found_by_look_alone == ""
+    assert anchoring.stop() == 0, anchoring.text
