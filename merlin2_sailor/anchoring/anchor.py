@@ -167,10 +167,12 @@ class Anchor:
     (look-alikes, each as likely to be it); empty when its identity is decided. The finder reports
     it instead of guessing, so a planner learns "not found: cannot tell which" rather than a lie."""
     found_by_look_alone: str = ""
-    """While MISSING: an anchor a search found that looks like this one where the camera had never
+    """An anchor a search for this one, MISSING, found that looks like it where the camera had never
     watched before it was seen (:class:`~.identity_repair.Unconfirmed`): a copy may have stood there
     all along. Taken for this one only when the search concludes, having seen no other copy
-    (:meth:`~.anchoring.Anchoring.conclude_search`); empty: none."""
+    (:meth:`~.anchoring.Anchoring.conclude_search`); cleared once taken, once a copy makes the case
+    undecided, or once the candidate is gone (a sighting of this anchor on the way does not clear
+    it: it may go missing again); empty: none."""
     parts_fit: np.ndarray | None = None
     """Where its box is the box around parts of it, joined (:mod:`.parts`), not a whole view's: the
     extent (:func:`turned_extent`) of the whole one of its class its parts were fit in, slack

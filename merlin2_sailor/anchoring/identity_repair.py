@@ -260,6 +260,14 @@ class IdentityRepair:
                 and colours_agree_in_any_light(other.colour, lost.colour, self.colour)
                 and self._anywhere(other, lost) >= self.match_threshold]
 
+    def _seen_elsewhere(self, sought: Anchor, found: Anchor) -> bool:
+        """Whether ``sought`` was perceived since ``found`` was first seen, away from where ``found``
+        stands (farther than the larger footprint of the two, plus the reappearance distance)."""
+        if sought.last_seen <= found.first_seen:
+            return False
+        reach = max(float(np.max(found.size[:2])), float(np.max(sought.size[:2]))) + self.config.reappearance_distance
+        return float(np.linalg.norm(sought.perceived_position[:2] - found.position[:2])) > reach
+
     def conclude_search(self, sought: Anchor, index: AnchorIndex) -> Decision | None:
         """A search that looked everywhere takes the candidate it found by look alone
         (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
@@ -268,7 +276,15 @@ class IdentityRepair:
         found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
         if sought.state is not AnchorState.MISSING or found is None or sought.indistinguishable_from:
             return None
-        if not self._possible(found, sought, include_missing=True):
+        # It was possible when found (born after the lost one's last sighting, near enough to have
+        # been carried there); a sighting of the lost anchor since, where the candidate stands, must
+        # not make it impossible now: a far view of the wheeled bicycle took the lost anchor for a
+        # moment during the search and left it missing again, and the candidate, born before that,
+        # was no longer possible (`large_object_wheeled_away`, network, seed 0, 6 December 2026).
+        # A sighting elsewhere since the candidate appeared says the lost object is not it.
+        if (found.class_name != sought.class_name or found.expectation is not None
+                or found.state not in (AnchorState.CONFIRMED, AnchorState.MISSING)
+                or anchor_colours_differ(found, sought, self.colour) or self._seen_elsewhere(sought, found)):
             return None
         score = self._anywhere(found, sought)
         twins = self._twins(sought, index, besides=found)
