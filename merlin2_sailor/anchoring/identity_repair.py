@@ -44,7 +44,9 @@ decision is :class:`Undecided`, naming the candidates, instead of a guess. A can
 better explained by another MISSING anchor (by the margin) is that anchor's business: nothing is
 decided for the lost one, and nothing is ambiguous either. And a search's find where the camera
 had never watched before it appeared is :class:`Undecided` when the robot knows a twin of the
-lost object: it may be another twin that was there all along (:meth:`IdentityRepair.decide_search`).
+lost object: it may be another twin that was there all along (:meth:`IdentityRepair.decide_search`);
+where it knows none, the find is only recorded (:class:`Unconfirmed`) until the search, having
+looked everywhere else, concludes (:meth:`IdentityRepair.conclude_search`).
 """
 
 from __future__ import annotations
