@@ -232,10 +232,10 @@ def reacquired(context: BehaviorContext, search: Search) -> AnchorReport | None:
     return max(candidates, key=lambda anchor: (anchor.last_seen, anchor.symbol), default=None)
 
 
-def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
+def wait_for_sighting(state: BehaviorState, search: Search) -> AnchorReport | None:
+    """The sought anchor once it is confirmed and seen since the search began, waiting up to
+    ``reacquire_timeout``; None when it was not (or the wait was cancelled)."""
     context = state.context
-    search: Search = blackboard[SEARCH_KEY]
-    stop = blackboard[STOP_KEY]
     found: list[AnchorReport] = []
 
     def seen() -> bool:
@@ -245,6 +245,16 @@ def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
         return anchor is not None
 
     if wait_until(seen, context.config.reacquire_timeout, context.config.poll_period, state):
+        return found[-1]
+    return None
+
+
+def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
+    context = state.context
+    search: Search = blackboard[SEARCH_KEY]
+    stop = blackboard[STOP_KEY]
+    found = wait_for_sighting(state, search)
+    if found is not None:
         elsewhere = seen_at(context, search)
         if elsewhere not in (None, stop):
             # Seen from here, but by another waypoint (the red mug, re-found in the bedroom while the
@@ -265,7 +275,7 @@ def check_here(state: BehaviorState, blackboard: Blackboard) -> str:
         note_look_alone(context, search, sought)
         context.log("info", f"{search.sought} is not at {stop}")
         return NOT_HERE
-    return found_here(state, blackboard, found[-1])
+    return found_here(state, blackboard, found)
 
 
 def found_here(state: BehaviorState, blackboard: Blackboard, anchor: AnchorReport) -> str:
@@ -350,16 +360,9 @@ def conclude(state: BehaviorState, blackboard: Blackboard) -> str:
     except BehaviorError as error:
         warn(context, blackboard, f"cannot conclude the search for {search.symbol} on {search.look_alone}: {error}")
         return NOT_HERE
-    found: list[AnchorReport] = []
-
-    def seen() -> bool:
-        anchor = reacquired(context, search)
-        if anchor is not None:
-            found.append(anchor)
-        return anchor is not None
-
-    if taken and wait_until(seen, context.config.reacquire_timeout, context.config.poll_period, state):
-        return found_here(state, blackboard, found[-1])
+    found = wait_for_sighting(state, search) if taken else None
+    if found is not None:
+        return found_here(state, blackboard, found)
     if state.is_canceled():
         return CANCEL
     if note_indistinguishable(context, search, context.anchoring.get_anchor(search.symbol)):
