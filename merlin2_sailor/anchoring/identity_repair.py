@@ -263,12 +263,15 @@ class IdentityRepair:
                 and self._anywhere(other, lost) >= self.match_threshold]
 
     def _seen_elsewhere(self, sought: Anchor, found: Anchor) -> bool:
-        """Whether ``sought`` was perceived since ``found`` was first seen, away from where ``found``
-        stands (farther than the larger footprint of the two, plus the reappearance distance)."""
-        if sought.last_seen <= found.first_seen:
+        """Whether ``sought`` was back (confirmed again, then lost) since ``found`` was first seen,
+        away from where ``found`` stands (farther than the larger footprint of the two, plus the
+        reappearance distance). A sighting too few to bring it back is no evidence: a false
+        detection in a searched disc took the lost bicycle's anchor once, 1.6 m from the wheeled
+        bicycle's (`large_object_wheeled_away`, network, seed 0, 6 December 2026)."""
+        if sought.lost_after is None or sought.lost_at is None or sought.lost_after <= found.first_seen:
             return False
         reach = max(float(np.max(found.size[:2])), float(np.max(sought.size[:2]))) + self.config.reappearance_distance
-        return float(np.linalg.norm(sought.perceived_position[:2] - found.position[:2])) > reach
+        return float(np.linalg.norm(sought.lost_at[:2] - found.position[:2])) > reach
 
     def conclude_search(self, sought: Anchor, index: AnchorIndex) -> Decision | None:
         """A search that looked everywhere takes the candidate it found by look alone

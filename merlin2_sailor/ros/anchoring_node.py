@@ -395,6 +395,8 @@ class AnchoringNode(Node):
             return response
         response.success = not refusal
         response.message = refusal
+        if refusal:
+            self.get_logger().info(f"a search for {request.symbol} concluded taking nothing: {refusal}")
         if result is not None and result.events:
             self._publish(result)  # a search that found its object under a newer anchor: the merge
         else:
@@ -408,6 +410,9 @@ def _not_concluded(anchor: Anchor | None) -> str:
         return ""
     if anchor.indistinguishable_from:
         return f"{anchor.symbol} cannot be told from {', '.join(anchor.indistinguishable_from)} (they look alike)"
+    if anchor.found_by_look_alone:
+        return (f"{anchor.found_by_look_alone}, found by its look alone, can no longer be {anchor.symbol} (gone, "
+                "moved by an action, of another colour, or the object was back elsewhere since)")
     return f"{anchor.symbol} has no candidate a search found by its look alone"
 
 

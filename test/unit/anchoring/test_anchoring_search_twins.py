@@ -215,21 +215,24 @@ def test_a_twin_missing_too_is_a_rival_not_a_reason_to_doubt(maker, matcher):
     assert ambiguous and anchoring.get(lost).state is AnchorState.MISSING
 
 
-@pytest.mark.parametrize(("seen_at", "taken"), [(LIVING_TABLE, True), ((-2.4, -0.1, 0.8), True),
-                                                (KITCHEN_TABLE, False), ((-2.5, 2.5, 0.8), False)])
-def test_a_sighting_of_the_lost_mug_since_the_find_counts_against_it_only_away_from_it(maker, matcher, seen_at,
-                                                                                        taken):
-    """While the search looks on, a view may take the lost anchor for a moment (a far view during a
-    search; it goes missing again): seen where the candidate stands, that is no evidence against
-    it; seen elsewhere after the candidate appeared, the lost object is not the candidate."""
+@pytest.mark.parametrize(("seen_at", "back", "taken"), [
+    (LIVING_TABLE, True, True), ((-2.4, -0.1, 0.8), True, True), (KITCHEN_TABLE, True, False),
+    ((-2.5, 2.5, 0.8), True, False), (KITCHEN_TABLE, False, True), ((-2.5, 2.5, 0.8), False, True)])
+def test_the_lost_mug_back_since_the_find_counts_against_it_only_away_from_it(maker, matcher, seen_at, back, taken):
+    """While the search looks on, the lost anchor may be back for a while (confirmed by views on
+    the way, then lost again): back where the candidate stands, that is no evidence against it;
+    back elsewhere after the candidate appeared, the lost object is not the candidate. A single
+    sighting while missing (``back`` False), too few to bring it back, is none either way."""
     anchoring = build(matcher)
     lost, stamp = lost_and_found(anchoring, maker, None)
     candidate = found_symbol(anchoring)
     search_living_room(anchoring, lost, stamp)
     anchoring.clear_expectation(lost)
     sought = anchoring.get(lost)
-    sought.last_seen = stamp + 1.0  # a sighting on the way, since the candidate appeared
+    sought.last_seen = stamp + 1.0  # seen on the way, since the candidate appeared
     sought.perceived_position = np.array(seen_at, dtype=np.float64)
-    assert sought.state is AnchorState.MISSING  # it went missing again
+    if back:  # confirmed there, then lost again (what going missing records)
+        sought.lost_after, sought.lost_at = sought.last_seen, sought.perceived_position.copy()
+    assert sought.state is AnchorState.MISSING
     events = [(event.kind, event.symbol) for event in anchoring.conclude_search(lost).events]
     assert events == ([(AnchorEventKind.FORGOTTEN, candidate), (AnchorEventKind.CONFIRMED, lost)] if taken else [])
