@@ -91,6 +91,16 @@ anchored anew from two views of its other side where it was wheeled to, differed
 anchored twice. In the same suite, the 181 pairs of anchors of different objects whose means differ
 with no common side differing differed by 0.175 or more.
 
+Every comparison takes the grey pixels' mid and light bins as one window (:func:`lit_alike`):
+light changes no hue, but a face turned from or to the light moves its grey pixels between them.
+Measured in the scenario suite (6 December 2026, network, seed 0): two red books of one make, one
+on a shelf and one on a desk turned another way, differed by 0.28, all of it mid grey gone light,
+so the desk's copy was no twin of the shelf's and a search claimed the shelf's
+(`removed_while_a_twin_is_unseen`); a shelf book's own view, its neighbour taken away, differed
+from its anchor by 0.19 in the mid bin and was held apart from it, and the removed twin's missing
+anchor took it (`twin_removed_from_the_shelf`). The dark bin stays apart: a black object is not a
+white one in any light. (The figures above were measured with the three bins apart.)
+
 Only a view standing in the anchor's place (within ``place_radius``, 0.5 m, and nearer to it than
 to any other anchor of its class: on a shelf, a book's view is not its neighbour's) counts against it: the
 matching table's gate reaches 3 m or more, and a view of the hall's book 3 m from the kitchen's
@@ -274,6 +284,7 @@ def colour_difference(first: ColourModel | None, second: ColourModel | None, con
     the object's colour varies."""
     if config.minimum_views == 0 or first is None or second is None:
         return 0.0
+    first, second = lit_alike(first), lit_alike(second)
     first_known, second_known = first.views >= config.minimum_views, second.views >= config.minimum_views
     if not (first_known or second_known):
         return 0.0
@@ -301,21 +312,10 @@ def colours_agree(first: ColourModel | None, second: ColourModel | None, config:
     return not colours_differ(first, second, config)
 
 
-def colours_agree_in_any_light(first: ColourModel | None, second: ColourModel | None,
-                               config: ColourEvidenceConfig) -> bool:
-    """:func:`colours_agree`, with the grey pixels' mid and light bins taken as one: whether two
-    anchors may be copies of one make lit differently. Light does not change a hue, but it moves the
-    grey pixels of a face between the mid and light bins (a face turned from the light is darker):
-    two red books of one make, one on a shelf and one on a desk turned another way, differed by
-    0.28, all of it mid grey gone light, and the desk's copy was no twin of the shelf's
-    (`removed_while_a_twin_is_unseen`, network, seed 0, 6 December 2026). What a copy is asked is
-    whether it could be the object, and that difference says nothing about it."""
-    return colours_agree(_lit_alike(first), _lit_alike(second), config)
-
-
-def _lit_alike(model: ColourModel | None) -> ColourModel | None:
-    """The model with its mid and light grey windows summed into the light one (the mid one empty);
-    their spreads are added, the larger of what their sum can vary by."""
+def lit_alike(model: ColourModel | None) -> ColourModel | None:
+    """The model with its mid and light grey windows summed into the light one (the mid one empty),
+    as every comparison takes it (see the module docstring); their spreads are added, the larger of
+    what their sum can vary by."""
     if model is None:
         return None
     mid, light = HUE_BINS + 1, HUE_BINS + 2
@@ -486,7 +486,7 @@ def view_gap_text(model: ColourBySize | None, histogram: np.ndarray | None, size
     difference = colour_difference(near, ColourModel.of(histogram), config)
     if near is None or difference <= 0.0:
         return ""
-    view = colour_windows(histogram)
+    near, view = lit_alike(near), lit_alike(ColourModel.of(histogram)).mean
     window = int(np.argmax(np.where(np.abs(near.mean - view) >= difference, np.abs(near.mean - view), -1.0)))
     return (f"{difference:.2f} in the {window_name(window)}: {near.mean[window]:.2f} in its {near.views} views, "
             f"{view[window]:.2f} in this one")
@@ -496,7 +496,7 @@ def window_name(window: int) -> str:
     """What a colour window of :func:`colour_windows` covers, in words."""
     if window < HUE_BINS:
         return f"hue window at {round(window * 360 / HUE_BINS)} deg"
-    return f"{('dark', 'mid', 'light')[window - HUE_BINS]} grey bin"
+    return ("dark grey bin", "mid grey bin", "mid and light grey bins")[window - HUE_BINS]
 
 
 def comparable_views_of(model: ColourBySize, size: float, bearing: float | None,

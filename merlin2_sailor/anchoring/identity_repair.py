@@ -60,12 +60,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import (
-    ColourEvidenceConfig,
-    anchor_colours_differ,
-    colours_agree,
-    colours_agree_in_any_light,
-)
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ, colours_agree
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.errors import ConfigurationError
@@ -259,7 +254,7 @@ class IdentityRepair:
         return [other for other in index.of_class(lost.class_name)
                 if other is not lost and other is not besides
                 and other.state in (AnchorState.CONFIRMED, AnchorState.MISSING)
-                and colours_agree_in_any_light(other.colour, lost.colour, self.colour)
+                and colours_agree(other.colour, lost.colour, self.colour)
                 and self._anywhere(other, lost) >= self.match_threshold]
 
     def _seen_elsewhere(self, sought: Anchor, found: Anchor) -> bool:
