@@ -237,6 +237,15 @@ class IdentityRepair:
         if self.arrival_frames <= 0 or self._arrived(merge.merged):
             return merge
         lost, found = merge.kept, merge.merged
+        recorded = index.get(lost.found_by_look_alone) if lost.found_by_look_alone else None
+        if recorded is not None and recorded is not found:
+            # Two finds by look alone, each taken for the lost object by the same test: which one
+            # it is (if either) cannot be told. The second dog found in a room never looked into had
+            # replaced the first as the candidate (`large_object_moved`, network, seed 0).
+            return Undecided((lost,), (found, recorded), (merge.score,),
+                             f"{found.symbol} and {recorded.symbol} both look like {lost.symbol}, each where the "
+                             "camera had not watched before it was seen: either may be a copy that stood there all "
+                             "along")
         twins = self._twins(lost, index, besides=found)
         if not twins:
             return Unconfirmed(lost, found, merge.score,

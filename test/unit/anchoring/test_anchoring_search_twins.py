@@ -15,6 +15,7 @@ found as a red book of its make on a shelf never looked into while another stood
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -66,7 +67,8 @@ def matcher(request):
     return None if request.param == "rules" else AppearanceRules()
 
 
-def lost_and_found(anchoring, maker, beside, living_room_watched: bool = False, twin_leaves: bool = False):
+def lost_and_found(anchoring, maker, beside, living_room_watched: bool = False, twin_leaves: bool = False,
+                   found_colour: bool = True):
     """The kitchen with the blue mug and ``beside`` (or nothing) on its table; the living room
     (watched first, with only a plant in view, when ``living_room_watched``); the kitchen again
     without the blue mug (and without ``beside`` when ``twin_leaves``); then the living room with
@@ -80,6 +82,8 @@ def lost_and_found(anchoring, maker, beside, living_room_watched: bool = False, 
     _, stamp = watch(anchoring, maker, KITCHEN, staying, 30.0, frames=3)
     assert anchoring.get(lost).state is AnchorState.MISSING
     found = mug("blue_found", BLUE, LIVING_TABLE, looks_like="blue")
+    if not found_colour:  # seen too far, or too briefly, for its colour to be known
+        found = dataclasses.replace(found, colour=None)
     _, stamp = watch(anchoring, maker, LIVING_ROOM, [PLANT, found] if living_room_watched else [found], stamp)
     return lost, stamp
 
@@ -236,3 +240,26 @@ def test_the_lost_mug_back_since_the_find_counts_against_it_only_away_from_it(ma
     assert sought.state is AnchorState.MISSING
     events = [(event.kind, event.symbol) for event in anchoring.conclude_search(lost).events]
     assert events == ([(AnchorEventKind.FORGOTTEN, candidate), (AnchorEventKind.CONFIRMED, lost)] if taken else [])
+
+
+@pytest.mark.parametrize("first_colour_known", [True, False])
+def test_a_second_find_by_look_alone_elsewhere_leaves_the_lost_mug_undecided(maker, matcher, first_colour_known):
+    """Two look-alikes found by look alone, each where the camera never watched, each taken for the
+    lost mug by the same test: the lost mug cannot be told from either, even where the first is no
+    twin by colour (its colour not known: seen too far away), which made the second replace it as
+    the candidate (`large_object_moved`, network, seed 0, 6 December 2026)."""
+    anchoring = build(matcher)
+    lost, stamp = lost_and_found(anchoring, maker, None, found_colour=first_colour_known)
+    candidate = found_symbol(anchoring)
+    search_living_room(anchoring, lost, stamp)
+    anchoring.clear_expectation(lost)
+    second = mug("blue_second", BLUE, HALL_SHELF, looks_like="blue")
+    _, stamp = watch(anchoring, maker, HALL, [second], stamp + 5.0)
+    second_symbol = symbol_at(anchoring, HALL_SHELF)
+    result = search_hall(anchoring, lost, stamp)
+    ambiguous = [event for event in result.events if event.kind is AnchorEventKind.AMBIGUOUS]
+    assert [event.symbol for event in ambiguous] == [lost]
+    assert set(ambiguous[0].details["candidates"].split(",")) == {candidate, second_symbol}
+    sought = anchoring.get(lost)
+    assert sought.found_by_look_alone == "" and set(sought.indistinguishable_from) == {candidate, second_symbol}
+    assert anchoring.conclude_search(lost).events == () and sought.state is AnchorState.MISSING
