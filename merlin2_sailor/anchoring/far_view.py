@@ -101,9 +101,11 @@ def nearest_anchor(table: MatchingTable, row: int, taken: np.ndarray) -> str:
     column = best_candidate(table, row)
     # Gated by colour: the view's colour ruled out an anchor whose own went unchecked a while.
     ruled_out = table.colour_ruled_out
-    by_colour = [] if ruled_out is None else sorted(table.anchors[column].symbol
-                                                    for column in np.flatnonzero(ruled_out[row]))
-    colour_text = f"{', '.join(by_colour)} ruled out by colour" if by_colour else ""
+    by_colour = [] if ruled_out is None else sorted(
+        (table.anchors[column].symbol, table.colour_gaps.get((row, int(column)), ""))
+        for column in np.flatnonzero(ruled_out[row]))
+    colour_text = ", ".join(f"{symbol} ruled out by colour" + (f" ({gap})" if gap else "")
+                            for symbol, gap in by_colour)
     if column is None:
         return colour_text
     anchor = table.anchors[column]

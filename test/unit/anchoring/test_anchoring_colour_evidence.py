@@ -414,7 +414,8 @@ def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
     anchoring, maker = rules(), PerceptMaker(seed=6)
     see(anchoring, maker, [red], 0.0)
     (acquired,) = acquired_events(anchoring, maker, [green], 61.0)
-    assert acquired.details["nearest_anchor"] == "cup_1 ruled out by colour"
+    assert re.fullmatch(r"cup_1 ruled out by colour \(0\.\d\d in the hue window at \d+ deg: 0\.\d\d in its \d+ views, "
+                        r"0\.\d\d in this one\)", acquired.details["nearest_anchor"]), acquired.details
     # With another mug in reach, the account names both: the best score, and the one ruled out.
     blue = SceneObject("blue", "cup", (2.6, 0.3, 0.8), colour=mug_colour(BLUE))
     anchoring, maker = rules(), PerceptMaker(seed=6)
@@ -422,7 +423,8 @@ def test_an_anchor_made_because_colour_ruled_out_the_old_one_says_so() -> None:
     see(anchoring, maker, [blue], 60.0, frames=1)
     (acquired,) = acquired_events(anchoring, maker, [green], 61.0)
     assert acquired.details["nearest_anchor"].startswith("cup_2 scored ")
-    assert acquired.details["nearest_anchor"].endswith("; cup_1 ruled out by colour")
+    assert re.search(r"; cup_1 ruled out by colour \(0\.\d\d in the hue window at \d+ deg: .* in this one\)$",
+                     acquired.details["nearest_anchor"]), acquired.details
 
 
 # --- a single view is held to views of about its size -----------------------------------------
