@@ -137,19 +137,30 @@ def search_hall(anchoring, symbol, stamp):
     return anchoring.expect(symbol, Expectation.at(np.array(HALL_SHELF), stamp, "hall", "find", radius=1.5))
 
 
+def search_looking_on(anchoring, maker, **lost_and_found_options):
+    """The lost mug found by look alone in the living room (recorded), and the search gone on:
+    (lost symbol, candidate symbol, stamp after)."""
+    lost, stamp = lost_and_found(anchoring, maker, None, **lost_and_found_options)
+    candidate = found_symbol(anchoring)
+    search_living_room(anchoring, lost, stamp)
+    anchoring.clear_expectation(lost)
+    return lost, candidate, stamp
+
+
+def seen_in_the_hall(anchoring, maker, identity, stamp):
+    """A blue mug looking like the lost one seen on the hall's shelf: (its symbol, stamp after)."""
+    _, stamp = watch(anchoring, maker, HALL, [mug(identity, BLUE, HALL_SHELF, looks_like="blue")], stamp + 5.0)
+    return symbol_at(anchoring, HALL_SHELF), stamp
+
+
 @pytest.mark.parametrize("copy_in_the_disc", [True, False])
 def test_a_copy_seen_after_a_find_by_look_alone_leaves_the_lost_mug_undecided(maker, matcher, copy_in_the_disc):
     """The search looks on after a find by look alone; a copy of the lost mug seen later, at the next
     stop (in its disc) or anywhere (on the way), shows that the look does not single it out: the
     lost mug cannot be told from either, and concluding takes neither."""
     anchoring = build(matcher)
-    lost, stamp = lost_and_found(anchoring, maker, None)
-    candidate = found_symbol(anchoring)
-    search_living_room(anchoring, lost, stamp)
-    anchoring.clear_expectation(lost)
-    copy = mug("blue_copy", BLUE, HALL_SHELF, looks_like="blue")
-    _, stamp = watch(anchoring, maker, HALL, [copy], stamp + 5.0)
-    copy_symbol = symbol_at(anchoring, HALL_SHELF)
+    lost, candidate, stamp = search_looking_on(anchoring, maker)
+    copy_symbol, stamp = seen_in_the_hall(anchoring, maker, "blue_copy", stamp)
     assert copy_symbol not in (lost, candidate)
     if copy_in_the_disc:
         result = search_hall(anchoring, lost, stamp)
@@ -228,10 +239,7 @@ def test_the_lost_mug_back_since_the_find_counts_against_it_only_away_from_it(ma
     back elsewhere after the candidate appeared, the lost object is not the candidate. A single
     sighting while missing (``back`` False), too few to bring it back, is none either way."""
     anchoring = build(matcher)
-    lost, stamp = lost_and_found(anchoring, maker, None)
-    candidate = found_symbol(anchoring)
-    search_living_room(anchoring, lost, stamp)
-    anchoring.clear_expectation(lost)
+    lost, candidate, stamp = search_looking_on(anchoring, maker)
     sought = anchoring.get(lost)
     sought.last_seen = stamp + 1.0  # seen on the way, since the candidate appeared
     sought.perceived_position = np.array(seen_at, dtype=np.float64)
@@ -249,13 +257,8 @@ def test_a_second_find_by_look_alone_elsewhere_leaves_the_lost_mug_undecided(mak
     twin by colour (its colour not known: seen too far away), which made the second replace it as
     the candidate (`large_object_moved`, network, seed 0, 6 December 2026)."""
     anchoring = build(matcher)
-    lost, stamp = lost_and_found(anchoring, maker, None, found_colour=first_colour_known)
-    candidate = found_symbol(anchoring)
-    search_living_room(anchoring, lost, stamp)
-    anchoring.clear_expectation(lost)
-    second = mug("blue_second", BLUE, HALL_SHELF, looks_like="blue")
-    _, stamp = watch(anchoring, maker, HALL, [second], stamp + 5.0)
-    second_symbol = symbol_at(anchoring, HALL_SHELF)
+    lost, candidate, stamp = search_looking_on(anchoring, maker, found_colour=first_colour_known)
+    second_symbol, stamp = seen_in_the_hall(anchoring, maker, "blue_second", stamp)
     result = search_hall(anchoring, lost, stamp)
     ambiguous = [event for event in result.events if event.kind is AnchorEventKind.AMBIGUOUS]
     assert [event.symbol for event in ambiguous] == [lost]
