@@ -493,6 +493,18 @@ class Anchoring:
         return anchor
 
 
+def conclusion_refusal(anchor: Anchor | None) -> str:
+    """Why a concluded search took nothing for ``anchor`` (empty: it took its candidate)."""
+    if anchor is None or anchor.state is not AnchorState.MISSING:
+        return ""
+    if anchor.indistinguishable_from:
+        return f"{anchor.symbol} cannot be told from {', '.join(anchor.indistinguishable_from)} (they look alike)"
+    if anchor.found_by_look_alone:
+        return (f"{anchor.found_by_look_alone}, found by its look alone, can no longer be {anchor.symbol} (gone, "
+                "moved by an action, of another colour, or the object was back elsewhere since)")
+    return f"{anchor.symbol} has no candidate a search found by its look alone"
+
+
 def _settled(renamed: dict[str, str]) -> dict[str, str]:
     """Each renamed symbol to the symbol it ends under, when a frame merged it twice (a part joined
     to an anchor that a search then took for the anchor it sought). A swap (two symbols renamed to

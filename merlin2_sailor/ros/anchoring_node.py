@@ -30,9 +30,9 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
-from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
+from merlin2_sailor.anchoring.anchor import AnchorState
 from merlin2_sailor.anchoring.anchor_view import AnchorView
-from merlin2_sailor.anchoring.anchoring import AnchoringResult
+from merlin2_sailor.anchoring.anchoring import AnchoringResult, conclusion_refusal
 from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.service import AnchoringService
@@ -387,7 +387,7 @@ class AnchoringNode(Node):
                     self._anchoring.clear_expectation(request.symbol)
                 elif request.expectation == request.CONCLUDE_SEARCH:
                     result = self._anchoring.conclude_search(request.symbol)
-                    refusal = _not_concluded(self._anchoring.get(request.symbol))
+                    refusal = conclusion_refusal(self._anchoring.get(request.symbol))
                 else:
                     raise ConfigurationError(f"unknown expectation {request.expectation}")
         except SailorError as error:
@@ -402,18 +402,6 @@ class AnchoringNode(Node):
         else:
             self._publish_state()
         return response
-
-
-def _not_concluded(anchor: Anchor | None) -> str:
-    """Why a concluded search took nothing for ``anchor`` (empty: it took its candidate)."""
-    if anchor is None or anchor.state is not AnchorState.MISSING:
-        return ""
-    if anchor.indistinguishable_from:
-        return f"{anchor.symbol} cannot be told from {', '.join(anchor.indistinguishable_from)} (they look alike)"
-    if anchor.found_by_look_alone:
-        return (f"{anchor.found_by_look_alone}, found by its look alone, can no longer be {anchor.symbol} (gone, "
-                "moved by an action, of another colour, or the object was back elsewhere since)")
-    return f"{anchor.symbol} has no candidate a search found by its look alone"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
