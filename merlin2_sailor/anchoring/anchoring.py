@@ -493,10 +493,17 @@ class Anchoring:
         return anchor
 
 
-def conclusion_refusal(anchor: Anchor | None) -> str:
-    """Why a concluded search took nothing for ``anchor`` (empty: it took its candidate)."""
+def conclusion_refusal(anchor: Anchor | None, result: AnchoringResult | None = None) -> str:
+    """Why a concluded search (``result``: what :meth:`Anchoring.conclude_search` changed) did not
+    find ``anchor`` (empty: it took its candidate and the object is in view)."""
     if anchor is None or anchor.state is not AnchorState.MISSING:
         return ""
+    taken = [forgotten.symbol for forgotten in (result.forgotten if result is not None else ())]
+    if taken:
+        # The candidate was merged, but was itself out of sight by then: the object was last seen
+        # where the candidate stood, and is not in view there now.
+        return (f"{anchor.symbol} took the sightings of {', '.join(taken)} (found by its look alone), which was "
+                f"itself out of sight when the search concluded: {anchor.symbol} stays missing where it was last seen")
     if anchor.indistinguishable_from:
         return f"{anchor.symbol} cannot be told from {', '.join(anchor.indistinguishable_from)} (they look alike)"
     if anchor.found_by_look_alone:

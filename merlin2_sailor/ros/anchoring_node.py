@@ -387,7 +387,7 @@ class AnchoringNode(Node):
                     self._anchoring.clear_expectation(request.symbol)
                 elif request.expectation == request.CONCLUDE_SEARCH:
                     result = self._anchoring.conclude_search(request.symbol)
-                    refusal = conclusion_refusal(self._anchoring.get(request.symbol))
+                    refusal = conclusion_refusal(self._anchoring.get(request.symbol), result)
                 else:
                     raise ConfigurationError(f"unknown expectation {request.expectation}")
         except SailorError as error:

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
+from merlin2_sailor.anchoring.anchoring import conclusion_refusal
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.watched_places import WatchConfig
 
@@ -184,6 +185,30 @@ def test_a_find_by_look_alone_that_is_forgotten_leaves_nothing_to_conclude_on(ma
     anchoring.forget(candidate)
     assert anchoring.conclude_search(lost).events == ()
     assert anchoring.get(lost).state is AnchorState.MISSING
+
+
+def test_a_concluded_search_says_why_it_found_nothing(maker, matcher):
+    """What the node answers the find action: nothing when the candidate was taken in view; the
+    candidate's name and "out of sight" when it was taken while itself missing (the object was
+    last seen there, and is not in view now); no candidate at all."""
+    anchoring = build(matcher)
+    lost, candidate, stamp = search_looking_on(anchoring, maker)
+    result = anchoring.conclude_search(lost)
+    assert conclusion_refusal(anchoring.get(lost), result) == ""
+
+    anchoring = build(matcher)
+    lost, candidate, stamp = search_looking_on(anchoring, maker)
+    watch(anchoring, maker, LIVING_ROOM, [PLANT], stamp, frames=3)  # the candidate gone from its table
+    assert anchoring.get(candidate).state is AnchorState.MISSING
+    result = anchoring.conclude_search(lost)
+    assert candidate not in anchoring and anchoring.get(lost).state is AnchorState.MISSING
+    refusal = conclusion_refusal(anchoring.get(lost), result)
+    assert candidate in refusal and "out of sight" in refusal
+
+    anchoring = build(matcher)
+    lost, _ = lost_and_found(anchoring, maker, None)
+    refusal = conclusion_refusal(anchoring.get(lost), anchoring.conclude_search(lost))
+    assert "no candidate" in refusal
 
 
 def test_a_find_by_look_alone_survives_a_snapshot(maker, matcher):
