@@ -155,6 +155,7 @@ class Anchoring:
         self._repair = IdentityRepair(
             self.matcher, self.config.match_threshold, self.config.repair, self.config.expectation_tolerance,
             self.config.colour, self.config.watch.frames_to_arrive, self.config.far_view.scale_ratio,
+            self.config.far_view.score_floor,
         )
         self._watched = WatchedPlaces(self.config.watch, self.config.visibility)
         self._index = AnchorIndex(self.config.index)
