@@ -276,7 +276,8 @@ class Anchor:
         return anchor
 
     def absorb(
-        self, percept: Percept, embedding: np.ndarray | None, config: FusionConfig, partial: bool = False
+        self, percept: Percept, embedding: np.ndarray | None, config: FusionConfig, partial: bool = False,
+        evidence: bool = True,
     ) -> None:
         """Reacquire: fuse one more percept of this object into the anchor (never overwrite).
 
@@ -289,6 +290,10 @@ class Anchor:
         at the next stop, was seen there only in parts, which left it at that stop's waypoint 0.5 m
         from the bicycle, as if perceived, when the search moved on (`large_object_wheeled_away`,
         network, seed 2, 6 December 2026).
+
+        A sighting that is no ``evidence`` of what the object looks like (a MISSING anchor's view too
+        few to bring it back, :func:`.observation.reacquire`) keeps it alive, places it and sizes it,
+        but its colour and look are not the object's.
         """
         self.times_seen += 1
         perceived = self.provenance is Provenance.PERCEIVED
@@ -303,6 +308,7 @@ class Anchor:
         if not partial:
             self.whole_views += 1
             self.size = fuse_size(self.size, percept.size, self.whole_views, config)
+        if not partial and evidence:
             self.colour = with_view(self.colour, percept.colour)
             self.colour_by_size = with_sized_view(self.colour_by_size, percept.colour, view_scale(percept),
                                                   view_bearing(percept))
@@ -314,7 +320,7 @@ class Anchor:
                 self.unverified_sightings = None
         self.class_votes = vote_class(self.class_votes, percept.class_name, percept.score)
         self.class_name = winning_class(self.class_votes, self.class_name)
-        if embedding is not None and not partial:  # a part's look is not the object's (matching_table)
+        if embedding is not None and not partial and evidence:  # a part's look is not the object's (matching_table)
             self.gallery, self.gallery_scales = add_view(self.gallery, self.gallery_scales, embedding,
                                                          view_scale(percept), config.gallery_size)
         if percept.tracker_id:

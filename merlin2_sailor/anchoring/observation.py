@@ -55,7 +55,14 @@ def reacquire(
     missing_since = anchor.missing_since
     partial = partial or smaller_than_known(percept, anchor)
     before_sighting(anchor, percept.stamp, lifecycle)
-    anchor.absorb(percept, percept.embedding, fusion, partial)
+    # A MISSING anchor's sighting too few to bring it back is no evidence of what the object looks
+    # like (it may be a false box, or a look-alike, in a searched disc): its colour and look join
+    # the anchor only once it is back. Three false "dog" boxes around a book, each taken in a
+    # searched disc by the kitchen dog's lost anchor and never bringing it back, gave it their
+    # colour (the only whole views it had), and the moved dog, recorded as found by its look, was
+    # then refused for another colour (`large_object_moved`, network, seed 2, 6 December 2026).
+    returning = was_missing and anchor.recovery_sightings + 1 >= lifecycle.confirm_after
+    anchor.absorb(percept, percept.embedding, fusion, partial, evidence=not was_missing or returning)
     became_confirmed = after_sighting(anchor, lifecycle)
     if anchor.state is AnchorState.MISSING:
         anchor.missing_since = missing_since  # not back yet: still on the clock that forgets it

@@ -19,7 +19,16 @@ from merlin2_sailor.anchoring import (
 )
 from merlin2_sailor.errors import ConfigurationError, InvalidInputError, SailorError
 
-from .anchoring_scenes import KITCHEN, TWIN_MUGS, SceneObject, camera_view, flat_depth, with_occluder
+from .anchoring_scenes import (
+    KITCHEN,
+    TWIN_MUGS,
+    AppearanceRules,
+    SceneObject,
+    camera_view,
+    flat_depth,
+    mug_colour,
+    with_occluder,
+)
 
 FRAME = 1.0 / 15.0  # seconds between frames
 
@@ -155,6 +164,42 @@ def test_sightings_of_a_missing_anchor_far_apart_do_not_bring_it_back(make_ancho
     assert anchoring.get("cup_1").state is AnchorState.MISSING
     result = anchoring.process([maker.percept(cup, 4.0 + FRAME)], camera_view(), 4.0 + FRAME)
     assert AnchorEventKind.CONFIRMED in kinds(result) and anchoring.get("cup_1").state is AnchorState.CONFIRMED
+
+
+@pytest.mark.parametrize("with_look", [False, True])
+def test_a_missing_anchors_sightings_that_do_not_bring_it_back_change_nothing_of_its_look(
+        make_anchoring, quick_lifecycle, maker, kitchen, with_look):
+    """Single views taken by a lost anchor, too few and too far apart to bring it back (a false box,
+    a look-alike in a searched disc), keep it alive but are no evidence of what its object looks
+    like: its colour and views stay what they were; the view that brings it back joins them.
+    Three false "dog" boxes around a book gave the kitchen dog's lost anchor their colour, and the
+    moved dog was refused for another colour (`large_object_moved`, seed 2)."""
+    lifecycle = dataclasses.replace(quick_lifecycle, confirm_within=1.0)
+    options = {"matcher": AppearanceRules()} if with_look else {}
+    anchoring = make_anchoring(AnchoringConfig(lifecycle=lifecycle), **options)  # confirm_after = 2
+    cup = dataclasses.replace(kitchen["red_cup"], colour=mug_colour(0))
+    for frame in range(3):
+        anchoring.process([maker.percept(cup, frame * FRAME)], camera_view(), frame * FRAME)
+    for frame in range(3, 8):
+        anchoring.process([], camera_view(), frame * FRAME)
+    lost = anchoring.get("cup_1")
+    assert lost.state is AnchorState.MISSING
+    colour_views, colour_seen = lost.colour.views, lost.colour_seen
+    gallery = None if lost.gallery is None else len(lost.gallery)
+    turned_away = camera_view(yaw=math.pi)
+    for stamp in (1.0, 2.5):
+        result = anchoring.process([maker.percept(cup, stamp)], camera_view(), stamp)
+        assert result.percept_symbols == ("cup_1",) and lost.state is AnchorState.MISSING
+        anchoring.process([], turned_away, stamp + 0.5)
+        assert lost.colour.views == colour_views and lost.colour_seen == colour_seen
+        assert (None if lost.gallery is None else len(lost.gallery)) == gallery
+    anchoring.process([maker.percept(cup, 4.0)], camera_view(), 4.0)
+    assert lost.state is AnchorState.MISSING and lost.colour.views == colour_views
+    anchoring.process([maker.percept(cup, 4.0 + FRAME)], camera_view(), 4.0 + FRAME)
+    assert lost.state is AnchorState.CONFIRMED and lost.colour.views == colour_views + 1
+    assert lost.colour_seen == 4.0 + FRAME
+    if with_look:
+        assert len(lost.gallery) > gallery
 
 
 def test_occluded_object_is_not_marked_missing(make_anchoring, maker, kitchen):
