@@ -35,6 +35,10 @@ blackboard), the robot searches for it:
    (``conclude_search``, then wait up to ``reacquire_timeout`` for the sought anchor to be
    reacquired) and success there as in 3. Refused, not reacquired in time, or the candidate's
    waypoint unreachable: as in 4. A search for a class has no anchor to conclude on.
+6. Found nowhere, with no candidate: the search still concludes (``conclude_search``) before it
+   gives up, and the anchoring layer reports the sought anchor indistinguishable from anchors the
+   search could not rule out, if any (of its colour, looking like it, possible by time and place):
+   the search then ends as in 4, "cannot be told from", rather than "not found".
 """
 
 from __future__ import annotations
@@ -326,6 +330,7 @@ def plan_conclusion(state: BehaviorState, blackboard: Blackboard) -> str:
         return EXHAUSTED
     note_look_alone(context, search, sought)
     if not search.look_alone:
+        ask_what_is_left_in_question(context, search)
         return EXHAUSTED
     if sought is None or sought.found_by_look_alone != search.look_alone:
         context.log("info", f"{search.look_alone} is no longer taken for {search.symbol}: not concluding on it")
@@ -347,6 +352,18 @@ def plan_conclusion(state: BehaviorState, blackboard: Blackboard) -> str:
     context.log("info", f"no other copy of {search.symbol} anywhere searched: going back to {search.look_alone} "
                         f"at {stop} to take it")
     return NEXT
+
+
+def ask_what_is_left_in_question(context: BehaviorContext, search: Search) -> None:
+    """Found nowhere: before saying "not found", conclude the search with the anchoring layer, which
+    reports the sought anchor indistinguishable from anchors the search could not rule out (of its
+    colour, looking like it, possible by time and place) rather than absent."""
+    try:
+        context.anchoring.conclude_search(search.symbol, FIND_SOURCE)
+    except BehaviorError as error:
+        context.log("warning", f"cannot conclude the search for {search.symbol}: {error}")
+        return
+    note_indistinguishable(context, search, context.anchoring.get_anchor(search.symbol))
 
 
 def conclude(state: BehaviorState, blackboard: Blackboard) -> str:

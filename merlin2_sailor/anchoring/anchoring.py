@@ -358,7 +358,8 @@ class Anchoring:
     def conclude_search(self, symbol: str, stamp: float | None = None) -> AnchoringResult:
         """A search for ``symbol`` has looked everywhere: take the anchor it found by look alone
         where the camera had never watched (``found_by_look_alone``) for it, unless a copy of it is
-        anchored by now (then AMBIGUOUS, naming them). The result holds the merge's events (none:
+        anchored by now (then AMBIGUOUS, naming them); without a candidate, AMBIGUOUS naming the
+        anchors the search left in question, if any. The result holds the merge's events (none:
         nothing was taken; the anchor says why in ``indistinguishable_from``, or had no candidate)."""
         anchor = self._require(symbol)
         when = self._latest_stamp if stamp is None else stamp

@@ -187,8 +187,8 @@ class IdentityRepair:
         """A candidate's views under this share of the size of the lost anchor's smallest view are
         left out of its score where it has others (:mod:`.anchor_comparison`); 0: all count."""
         self.firm_rejection = firm_rejection
-        """A score below it is a firm "another object" (:mod:`.far_view`'s floor); a search's
-        candidate scored between it and the threshold is not ruled out (:meth:`_not_ruled_out`)."""
+        """A score below it is a firm "another object" (:mod:`.far_view`'s floor); an anchor a
+        search scored above it is not ruled out (:meth:`_left_in_question`)."""
 
     def _scores(self, candidates: Sequence[Anchor], lost: Anchor, disc: SearchedDisc) -> np.ndarray:
         return identity_scores(self.matcher, candidates, lost, disc, self.far_view_ratio)
@@ -210,39 +210,7 @@ class IdentityRepair:
             and float(np.linalg.norm(anchor.position[:2] - disc.centre[:2])) <= reach
         ]
         decision = self._decide(sought, candidates, index, lambda _: disc, reason="found by search", moved=True)
-        if decision is None:
-            return self._not_ruled_out(sought, candidates, disc)
         return self._unless_a_twin_stood_there(decision, index) if isinstance(decision, Merge) else decision
-
-    def _not_ruled_out(self, sought: Anchor, candidates: Sequence[Anchor], disc: SearchedDisc) -> Undecided | None:
-        """:class:`Undecided` when a candidate the search scored under the threshold is still not ruled
-        out: it could have been carried there since the sought object was lost, its colour agrees
-        with the sought one's (both known), the matching function takes it for the sought object by
-        everything but where it stands, and the search's own score is no firm rejection. Then "not
-        found" would be a guess: the object may stand right there.
-
-        Why. The learned matching function, shown a candidate in a searched disc, hedges on a look
-        alone (it was trained on searched pairs that include identical twins, which no look tells
-        apart) and more the longer the object was missing (its searched true pairs were copies of
-        pairs seen moments apart): the hall's blue mug, moved to the living room while its twin
-        stood in the kitchen, scored 0.35 in the living room's disc (views 0.14-0.73) and 0.95 by
-        everything but place, and the search reported it "not found" though it stood in the disc
-        (`moved_while_its_twin_is_watched`, network, seed 1, 6 December 2026). Which object it is
-        the evidence cannot say; that it is absent the evidence does not say either."""
-        if not candidates or self.firm_rejection <= 0.0:
-            return None
-        scores = self._scores(candidates, sought, disc)
-        hedged = [(candidate, float(score)) for candidate, score in zip(candidates, scores, strict=True)
-                  if self.firm_rejection <= score < self.match_threshold
-                  and colours_agree(candidate.colour, sought.colour, self.colour)
-                  and self._anywhere(candidate, sought) >= self.match_threshold]
-        if not hedged:
-            return None
-        hedged.sort(key=lambda pair: -pair[1])
-        named = ", ".join(f"{candidate.symbol} ({score:.2f})" for candidate, score in hedged)
-        return Undecided((sought,), tuple(candidate for candidate, _ in hedged), tuple(score for _, score in hedged),
-                         f"{named} may be {sought.symbol}: its colour agrees and it looks like it, but the search "
-                         "could not tell it from a copy")
 
     def _unless_a_twin_stood_there(self, merge: Merge, index: AnchorIndex) -> Decision:
         """The search's merge; :class:`Undecided` when its candidate may be another look-alike of
@@ -316,10 +284,13 @@ class IdentityRepair:
         """A search that looked everywhere takes the candidate it found by look alone
         (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
         of it is anchored by now (:class:`Undecided`) or the candidate is gone or no longer
-        possible (None: nothing to take)."""
-        found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
-        if sought.state is not AnchorState.MISSING or found is None or sought.indistinguishable_from:
+        possible (None: nothing to take). Without a candidate, an :class:`Undecided` when the
+        search left anchors in question (:meth:`_left_in_question`)."""
+        if sought.state is not AnchorState.MISSING or sought.indistinguishable_from:
             return None
+        found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
+        if found is None:
+            return self._left_in_question(sought, index)
         # It was possible when found (born after the lost one's last sighting, near enough to have
         # been carried there); a sighting of the lost anchor since, where the candidate stands, must
         # not make it impossible now: a far view of the wheeled bicycle took the lost anchor for a
@@ -337,6 +308,45 @@ class IdentityRepair:
                              f"{found.symbol} looks like {sought.symbol} but so does "
                              f"{', '.join(sorted(other.symbol for other in twins))}: it may be another copy")
         return Merge(sought, found, score, "found by search; no other copy anywhere searched", moved=True)
+
+    def _left_in_question(self, sought: Anchor, index: AnchorIndex) -> Undecided | None:
+        """For a search that looked everywhere and found nothing: :class:`Undecided` naming the
+        anchors it leaves in question, else None ("not found" is then what the evidence says).
+
+        An anchor is in question when it could have been carried where it stands since the sought
+        object was lost, its colour agrees with the sought one's (both known), the matching
+        function takes it for the sought object by everything but where it stands, and, scored as
+        a search scores it (in a searched disc), it is no firm rejection (the far-view floor).
+
+        Why. The learned matching function, shown a candidate in a searched disc, hedges on a look
+        alone (it was trained on searched pairs whose false ones include identical twins, which no
+        look tells apart, and whose true ones were seen moments apart): the hall's blue mug, moved
+        to the living room while its twin stood in the kitchen, scored 0.35 in the living room's
+        disc (views 0.14-0.73) and 0.95 by everything but place, and the search reported it "not
+        found" though it stood in the disc (`moved_while_its_twin_is_watched`, network, seed 1,
+        6 December 2026). Asked at each stop instead, the rule ended the search on a first far view
+        (0.39) of the red mug moved to the bedroom, which closer views took for it (0.70):
+        `moved_to_the_far_room`, seed 2. Which object it is, the evidence cannot say; that it is
+        absent, the evidence does not say either."""
+        if self.firm_rejection <= 0.0:
+            return None
+        in_question: list[tuple[Anchor, float]] = []
+        for candidate in index.of_class(sought.class_name):
+            if not (self._possible(candidate, sought, include_missing=True)
+                    and colours_agree(candidate.colour, sought.colour, self.colour)):
+                continue
+            searched = float(self._scores([candidate], sought, SearchedDisc(candidate.position,
+                                                                              self.search_tolerance))[0])
+            if searched >= self.firm_rejection and self._anywhere(candidate, sought) >= self.match_threshold:
+                in_question.append((candidate, searched))
+        if not in_question:
+            return None
+        in_question.sort(key=lambda pair: (-pair[1], pair[0].symbol))
+        named = ", ".join(f"{candidate.symbol} ({score:.2f})" for candidate, score in in_question)
+        return Undecided((sought,), tuple(candidate for candidate, _ in in_question),
+                         tuple(score for _, score in in_question),
+                         f"the search found nothing it could take for {sought.symbol}, but left {named} in question: "
+                         "of its colour, looking like it, and possible by time and place")
 
     # --- reappearances ----------------------------------------------------------------------
 

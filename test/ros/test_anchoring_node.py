@@ -312,6 +312,8 @@ def test_a_search_concludes_on_a_find_by_look_alone_over_dds(tmp_path, ros_probe
     while time.monotonic() < deadline and gone["cup_1"].state != Anchor.STATE_MISSING:
         camera.frame([])
         gone = latest_anchors(ros_probe, timeout=2.0)
+    refused = expect(srv.ExpectAnchor.Request.CONCLUDE_SEARCH)  # nothing else anchored: nothing to take
+    assert not refused.success and "no candidate" in refused.message
     carried = time.monotonic() + 6.5 / RepairConfig().carry_speed + 0.5
     anchors = gone
     while time.monotonic() < deadline and not (
@@ -320,9 +322,6 @@ def test_a_search_concludes_on_a_find_by_look_alone_over_dds(tmp_path, ros_probe
         anchors = latest_anchors(ros_probe, timeout=2.0)
     assert anchors["cup_1"].state == Anchor.STATE_MISSING and anchors["cup_2"].state == Anchor.STATE_CONFIRMED, (
         sorted(anchors), anchoring.text)
-    refused = expect(srv.ExpectAnchor.Request.CONCLUDE_SEARCH)
-    assert not refused.success and "no candidate" in refused.message
-
     search = expect(srv.ExpectAnchor.Request.EXPECT_AT, position=Point(x=-3.0, y=0.0, z=0.8), place="living_room",
                     radius=1.5)
     assert search.success, search.message

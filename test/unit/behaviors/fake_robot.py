@@ -109,6 +109,9 @@ class FakeAnchoring:
     down: bool = False
     refuse_conclusions: bool = False
     """conclude_search answers False whatever the reports say (the anchoring layer did not take it)."""
+    left_in_question: tuple[str, ...] = ()
+    """What a search concluded with no candidate leaves in question: the anchoring layer then reports
+    the sought anchor indistinguishable from these (empty: not found)."""
     _clock: itertools.count = field(default_factory=lambda: itertools.count(100))
 
     def add(self, symbol: str, class_name: str, position: tuple[float, float, float],
@@ -175,10 +178,14 @@ class FakeAnchoring:
 
     def conclude_search(self, symbol: str, source: str) -> bool:
         """Like the real one: the candidate found by look alone becomes the sought anchor (confirmed
-        where the candidate is, seen now; the candidate's report is gone), unless a copy turned up."""
+        where the candidate is, seen now; the candidate's report is gone), unless a copy turned up;
+        with no candidate, the anchors ``left_in_question`` make the sought one indistinguishable."""
         self._check()
         self.expectations.append(Expectation("conclude", symbol, (0.0, 0.0, 0.0), "", source))
         sought = self.anchors.get(symbol)
+        if sought is not None and not sought.found_by_look_alone and self.left_in_question:
+            self.report(symbol, indistinguishable_from=self.left_in_question)
+            return False
         if (self.refuse_conclusions or sought is None or sought.indistinguishable_from
                 or sought.found_by_look_alone not in self.anchors):
             return False

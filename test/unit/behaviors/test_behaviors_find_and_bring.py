@@ -92,6 +92,20 @@ def test_find_that_finds_nothing_aborts_after_every_waypoint_and_returns_to_its_
     assert blackboard[REASON_KEY] == "cup_1 was not found at b, a, d, c"
     assert stops(robot) == ["b", "a", "d", "c", "a"]  # back where the dispatcher will say it is
     assert robot_locations(robot.store) == ("a",)  # untouched by the behaviour
+    kinds = [e.kind for e in robot.anchoring.expectations]
+    assert kinds.count("conclude") == 1 and kinds[-1] == "conclude"  # asked before saying "not found"
+
+
+def test_find_that_finds_nothing_but_leaves_a_look_alike_in_question_ends_unable_to_tell(robot: FakeRobot) -> None:
+    """Concluded with no candidate, the anchoring layer reports the sought anchor indistinguishable
+    from an anchor the search could not rule out: the find says "cannot be told from", not "not
+    found", from its origin."""
+    robot.anchoring.left_in_question = ("cup_9",)
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == ABORT
+    assert blackboard[REASON_KEY] == "cup_1 cannot be told from cup_9 (they look alike): its identity is unknown"
+    assert stops(robot) == ["b", "a", "d", "c", "a"]
+    assert FOUND_SYMBOL_KEY not in blackboard
 
 
 def test_find_that_finds_only_look_alikes_it_cannot_tell_apart_ends_unsuccessful_saying_so(
