@@ -63,6 +63,12 @@ def sightings_doubled(anchor: Anchor, config: LifecycleConfig) -> bool:
     return anchor.times_seen >= 2 * config.confirm_after and doubled(anchor.times_seen, config.confirm_after)
 
 
+def sighting_brings_back(anchor: Anchor, config: LifecycleConfig) -> bool:
+    """Whether one more sighting (before :func:`after_sighting` counts it) brings a MISSING anchor
+    back: its ``confirm_after``-th of this visit."""
+    return anchor.recovery_sightings + 1 >= config.confirm_after
+
+
 def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
     """Update the state after an acquire or reacquire; True when the anchor became CONFIRMED.
 
@@ -71,8 +77,9 @@ def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
     detection near its old place must not tell a planner that a lost object is found.
     """
     if anchor.state is AnchorState.MISSING:
+        back = sighting_brings_back(anchor, config)
         anchor.recovery_sightings += 1
-        if anchor.recovery_sightings < config.confirm_after:
+        if not back:
             return False
         anchor.recovery_sightings = 0
         anchor.state = AnchorState.CONFIRMED

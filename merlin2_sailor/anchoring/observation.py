@@ -15,7 +15,7 @@ from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.expectation import ExpectationKind
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting, before_sighting
+from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting, before_sighting, sighting_brings_back
 from merlin2_sailor.anchoring.partial_view import smaller_than_known
 from merlin2_sailor.anchoring.percept_checks import position_text
 from merlin2_sailor.contract.percept import Percept
@@ -61,7 +61,7 @@ def reacquire(
     # searched disc by the kitchen dog's lost anchor and never bringing it back, gave it their
     # colour (the only whole views it had), and the moved dog, recorded as found by its look, was
     # then refused for another colour (`large_object_moved`, network, seed 2, 6 December 2026).
-    returning = was_missing and anchor.recovery_sightings + 1 >= lifecycle.confirm_after
+    returning = was_missing and sighting_brings_back(anchor, lifecycle)
     anchor.absorb(percept, percept.embedding, fusion, partial, evidence=not was_missing or returning)
     became_confirmed = after_sighting(anchor, lifecycle)
     if anchor.state is AnchorState.MISSING:
