@@ -118,7 +118,7 @@ def apply_decision(
         if decision.score is not None:
             evidence["score"] = round(decision.score, 3)
         changes.event(AnchorEventKind.FORGOTTEN, duplicate.symbol,
-                      reason=f"{decision.reason}: a second anchor of its object", **evidence)
+                      reason=decision.explanation, **evidence)
         return
     if isinstance(decision, Unconfirmed):
         # Nothing merged, nothing said yet: the search looks on (see identity_repair).

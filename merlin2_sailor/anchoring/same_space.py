@@ -24,6 +24,18 @@ anchor older than the one seen takes it over (a :class:`~.identity_repair.Merge`
 MISSING one is forgotten as a :class:`Duplicate` (its few sightings were the slip's). A pair that
 never stood together (the seen one born after the missing one's last sighting) is not a slip but
 perhaps an object put in another's place, which the reappearance rules judge instead.
+
+Nor can one object's space hold two: a MISSING anchor inside whose box two anchors of its class
+seen this frame each lie (at least ``minimum_overlap`` of each inside it, each smaller than it),
+two that were seen at one time and so are two objects, was anchored from a box drawn across both
+(a detector's box around two books of a shelf, its depth the books' own), not from an object of
+its own. It is forgotten as a :class:`Duplicate` of the one most inside it. Neither colour nor
+look is asked: a box across two objects blends both, so it is like neither. Measured in the
+scenario suite (`twin_removed_from_the_shelf`, network, seed 2, 6 December 2026): a book anchor
+born of such a box stood MISSING between two shelf books for the rest of the mission (its colour
+differed from each, so the pairwise rule above left it), a duplicate of the scorecard. A part's
+anchor is never two objects' (:mod:`.parts`: parts are never seen at one time), so a whole object
+seen only in parts is left alone.
 """
 
 from __future__ import annotations
@@ -52,6 +64,17 @@ class Duplicate:
     overlap: float
     reason: str
     score: float | None = None
+
+    @property
+    def explanation(self) -> str:
+        """What the FORGOTTEN event says of it."""
+        if self.reason.startswith(ACROSS):
+            return f"{self.reason}: not an object of its own"
+        return f"{self.reason}: a second anchor of its object"
+
+
+#: How the reason of a :class:`Duplicate` drawn across two objects begins.
+ACROSS = "a box across"
 
 
 def shared_volume(first: Anchor, second: Anchor) -> float:
@@ -92,19 +115,56 @@ def decide_same_space(
                 decisions.append(Merge(other, anchor, overlap, "a second anchor in the same space", moved=True))
             else:
                 decisions.append(Duplicate(anchor, other, overlap, f"in the same space as {anchor.symbol}"))
+    decisions.extend(_boxes_across(anchors, index, radius, minimum_overlap, settled))
     return decisions
+
+
+def _boxes_across(
+    seen: list[Anchor], index: AnchorIndex, radius: float, minimum_overlap: float, settled: set[str]
+) -> list[Duplicate]:
+    """MISSING anchors whose space two of the ``seen`` anchors, two objects, fill (module docstring)."""
+    inside: dict[str, list[tuple[float, Anchor]]] = {}
+    missing: dict[str, Anchor] = {}
+    for anchor, slots in zip(seen, index.within(np.array([a.position for a in seen]), radius), strict=True):
+        for other in index.anchors_at(slots):
+            if other.symbol in settled or anchor.symbol in settled or not _stood_with(anchor, other):
+                continue
+            if float(np.prod(anchor.size)) >= float(np.prod(other.size)):
+                continue
+            overlap = shared_volume(anchor, other)
+            if overlap >= minimum_overlap:
+                inside.setdefault(other.symbol, []).append((overlap, anchor))
+                missing[other.symbol] = other
+    duplicates = []
+    for symbol, held in inside.items():
+        held.sort(key=lambda pair: -pair[0])
+        pairs = [(first, second) for i, (_, first) in enumerate(held) for _, second in held[i + 1:]
+                 if second.symbol in first.seen_with or first.symbol in second.seen_with]
+        if not pairs:
+            continue
+        first, second = pairs[0]
+        overlap = next(share for share, anchor in held if anchor is first)
+        duplicates.append(Duplicate(first, missing[symbol], overlap,
+                                    f"{ACROSS} {first.symbol} and {second.symbol}, which fill its space"))
+        settled.add(symbol)
+    return duplicates
 
 
 def _may_be_one(seen: Anchor, missing: Anchor, colour: ColourEvidenceConfig) -> bool:
     """A MISSING anchor of the seen one's class, with nothing expected of it, that stood together
     with it at some time, and not of another colour."""
+    return _stood_with(seen, missing) and not anchor_colours_differ(seen, missing, colour)
+
+
+def _stood_with(seen: Anchor, missing: Anchor) -> bool:
+    """A MISSING anchor of the seen one's class, with nothing expected of it, that stood together
+    with it at some time."""
     return (
         missing is not seen
         and missing.state is AnchorState.MISSING
         and missing.expectation is None
         and missing.class_name == seen.class_name
         and seen.first_seen < missing.last_seen
-        and not anchor_colours_differ(seen, missing, colour)
     )
 
 

@@ -5,7 +5,9 @@ drove, left one book with a second anchor, MISSING on the spot where the first i
 matchers), and the long search of `removed` left birds, cats and books the same way. Tested
 below on a detector that reports one mug twice for a while, then on the rules' limits: two books
 side by side, a mug of another colour in a lost mug's place, a pair that never stood together, a
-sought anchor, and which symbol stays.
+sought anchor, and which symbol stays. Then a missing anchor born of a box drawn across two
+books, whose space the two fill (`twin_removed_from_the_shelf`, network, seed 2), against a removed
+book between its neighbours and the parts of one object.
 """
 
 from __future__ import annotations
@@ -147,3 +149,98 @@ def test_an_appearance_matcher_must_also_take_one_for_the_other():
     seen.gallery = to_bfloat16_bits(blue.reshape(1, -1))  # the same look: one object, as before
     [merge] = decide_same_space([seen], index, 0.5, COLOUR, AppearanceRules(), 0.5)
     assert isinstance(merge, Merge) and merge.kept is older_missing
+
+
+# A box drawn across two objects: the anchor it left is no object's.
+
+def strongly(hue: int) -> np.ndarray:
+    """A book's colour, 40 % of its pixels in its own hue."""
+    return mug_colour(hue, 0.4)
+
+
+BLEND = (strongly(RED) + strongly(GREEN)) / 2.0
+
+
+def coloured(anchor: Anchor, histogram: np.ndarray) -> Anchor:
+    anchor.colour = ColourModel.of(histogram)
+    for _ in range(4):
+        anchor.colour.add(histogram)
+    return anchor
+
+
+def wide_book(symbol: str, x: float, state: AnchorState, first_seen: float, last_seen: float) -> Anchor:
+    """An anchor of a box across two books standing side by side at x - 0.09 and x + 0.09: its
+    colour blends theirs."""
+    anchor = coloured(book(symbol, x, state, first_seen, last_seen), BLEND)
+    anchor.size = np.array((0.34, 0.04, 0.24))
+    return anchor
+
+
+def shelf_book(symbol: str, x: float, first_seen: float, hue: int) -> Anchor:
+    return coloured(book(symbol, x, AnchorState.CONFIRMED, first_seen, 60.0), strongly(hue))
+
+
+def seen_together(*anchors: Anchor) -> tuple[Anchor, ...]:
+    for anchor in anchors:
+        anchor.seen_with.update(other.symbol for other in anchors if other is not anchor)
+    return anchors
+
+
+def test_a_missing_anchor_whose_space_two_books_seen_at_one_time_fill_is_forgotten():
+    left, right = seen_together(shelf_book("book_1", 1.91, 0.0, RED), shelf_book("book_2", 2.09, 0.0, GREEN))
+    across = wide_book("book_3", 2.0, AnchorState.MISSING, 10.0, 20.0)
+    assert decide(left, across) == [] and decide(right, across) == []  # each alone: another colour
+    [duplicate] = decide(left, right, across)
+    assert isinstance(duplicate, Duplicate) and duplicate.duplicate is across
+    assert duplicate.kept in (left, right)
+    assert duplicate.reason.startswith("a box across")
+    assert duplicate.explanation.endswith("not an object of its own")
+
+
+def test_parts_of_one_object_never_seen_at_one_time_leave_the_whole_ones_anchor_alone():
+    """Two views of one long object's ends, each in its own frames, inside its missing anchor."""
+    left, right = shelf_book("book_1", 1.91, 0.0, RED), shelf_book("book_2", 2.09, 0.0, GREEN)
+    across = wide_book("book_3", 2.0, AnchorState.MISSING, 10.0, 20.0)
+    assert decide(left, right, across) == []
+
+
+def test_a_removed_book_between_two_seen_neighbours_keeps_its_anchor():
+    """Its box, as large as theirs, only grazes them: the space is empty, not filled by them."""
+    left, right = seen_together(shelf_book("book_1", 1.83, 0.0, RED), shelf_book("book_3", 2.17, 0.0, GREEN))
+    removed = coloured(book("book_2", 2.0, AnchorState.MISSING, 0.0, 30.0), strongly(RED))
+    assert decide(left, right, removed) == []
+    removed.size = np.array((0.2, 0.04, 0.24))  # boxes a little too large: still a book of its own
+    assert decide(left, right, removed) == []
+
+
+def test_one_anchor_inside_a_larger_missing_one_is_the_pairwise_rules_not_this_ones():
+    """One book seen inside a wider missing anchor of another colour: no evidence of two objects."""
+    [single] = seen_together(shelf_book("book_1", 1.91, 0.0, GREEN))
+    assert decide(single, wide_book("book_3", 2.0, AnchorState.MISSING, 10.0, 20.0)) == []
+
+
+def test_a_sought_anchor_or_one_never_seen_with_the_two_is_left_alone():
+    left, right = seen_together(shelf_book("book_1", 1.91, 30.0, RED), shelf_book("book_2", 2.09, 30.0, GREEN))
+    earlier = wide_book("book_3", 2.0, AnchorState.MISSING, 0.0, 20.0)  # lost before they came
+    assert decide(left, right, earlier) == []
+    sought = wide_book("book_3", 2.0, AnchorState.MISSING, 10.0, 40.0)
+    sought.expectation = Expectation.at(sought.position, 55.0, "living_room", "find", radius=1.0)
+    assert decide(left, right, sought) == []
+
+
+def test_a_detector_drawing_one_box_across_two_books_for_a_while_leaves_two_anchors():
+    maker = PerceptMaker(seed=11)
+    lifecycle = LifecycleConfig(confirm_after=2, missed_frames_to_missing=1, forget_after=600.0)
+    anchoring = Anchoring(AnchoringConfig(lifecycle=lifecycle))
+    red = SceneObject("red", "book", (2.5, -0.09, 0.8), size=(0.04, 0.16, 0.24), colour=strongly(RED))
+    green = SceneObject("green", "book", (2.5, 0.09, 0.8), size=(0.04, 0.16, 0.24), colour=strongly(GREEN))
+    across = SceneObject("across", "book", (2.5, 0.0, 0.8), size=(0.04, 0.34, 0.24), colour=BLEND)
+    stamp, events = 0.0, []
+    for frame in range(30):
+        items = [red, green, across] if 8 <= frame < 14 else [red, green]
+        result = anchoring.process([maker.percept(item, stamp) for item in items], camera_view(), stamp)
+        events.extend(result.events)
+        stamp += FRAME
+    assert [a.state for a in anchoring.anchors] == [AnchorState.CONFIRMED] * 2
+    [gone] = [e for e in events if e.kind is AnchorEventKind.FORGOTTEN]
+    assert gone.details["reason"].startswith("a box across")
