@@ -146,6 +146,9 @@ class Anchor:
     """Consecutive frames in which it should have been visible and was not reacquired."""
     recovery_sightings: int = 0
     """Sightings since the anchor went missing; it is confirmed again after ``confirm_after``."""
+    recovery_at: np.ndarray | None = None
+    """While MISSING: where the latest of those sightings perceived it (they must stand together,
+    :func:`.lifecycle.before_sighting`). Not persisted: it matters for seconds."""
     missing_since: float | None = None
     lost_after: float | None = None
     """While MISSING: its last sighting before it went missing (later sightings while missing,

@@ -19,9 +19,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.doubling import doubled
+from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
+
+#: How far (m, horizontally) two sightings of a MISSING anchor's way back may stand apart beyond
+#: half the diagonal of the object's footprint: the noise of two views' positions at a search's
+#: ranges (a part of a large object is centred up to half its extent off the whole).
+RECOVERY_PLACE_SLACK = 0.3
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,9 +102,12 @@ def after_sighting(anchor: Anchor, config: LifecycleConfig) -> bool:
     return False
 
 
-def before_sighting(anchor: Anchor, stamp: float, config: LifecycleConfig) -> None:
+def before_sighting(anchor: Anchor, percept: Percept, config: LifecycleConfig) -> None:
     """A tentative anchor must earn its confirmation in one visit, and a MISSING one its return: a
-    sighting more than ``confirm_within`` after its last one starts its count again.
+    sighting more than ``confirm_within`` after its last one starts its count again. A MISSING
+    anchor's way back must also be seen in one place: a sighting farther from the previous one of
+    the way back than half the diagonal of the object's footprint plus
+    :data:`RECOVERY_PLACE_SLACK` starts it again (:func:`recovery_moved`).
 
     Why. A tentative anchor is forgotten that long after it should have been seen and was not,
     but one out of view, or judged hidden, is never on that clock: measured in the MERLIN2 mission
@@ -115,6 +126,7 @@ def before_sighting(anchor: Anchor, stamp: float, config: LifecycleConfig) -> No
     in the hall, that anchor could never be the blue mug, and the search for it gave up
     (scenario suite, `moved_while_its_twin_is_watched`, network, seed 2, 5 December 2026).
     """
+    stamp = percept.stamp
     if anchor.state is AnchorState.TENTATIVE and stamp - anchor.last_seen > config.confirm_within:
         anchor.times_seen = 0
         anchor.first_seen = stamp
@@ -125,6 +137,28 @@ def before_sighting(anchor: Anchor, stamp: float, config: LifecycleConfig) -> No
         # wall), brought a lost bicycle back in the middle of the kitchen (scenario suite,
         # `large_object_wheeled_away`, network, seed 0, 6 December 2026).
         anchor.recovery_sightings = 0
+    if anchor.state is AnchorState.MISSING:
+        if recovery_moved(anchor, percept):
+            anchor.recovery_sightings = 0
+        anchor.recovery_at = np.asarray(percept.position, dtype=np.float64).copy()
+
+
+def recovery_moved(anchor: Anchor, percept: Percept) -> bool:
+    """Whether ``percept`` stands too far from the previous sighting of a MISSING anchor's way
+    back to be of the same object (False where the way back has not begun).
+
+    Why. A search takes a view of the sought class anywhere in a disc 3 m wide, and each sighting
+    that the search takes counts towards the anchor's return: two views of the moved bicycle in
+    the living room and, 2.5 s later, a false "bicycle" box on the kitchen wall beside the door,
+    1.9 m from them, brought the bicycle back on the wall; the search reported it found in the
+    kitchen (scenario suite, `large_object_wheeled_away`, network, seed 0, 6 December 2026). One
+    object's views in one visit stand together; views of two places are two things, and neither
+    has been seen ``confirm_after`` times."""
+    if anchor.recovery_sightings == 0 or anchor.recovery_at is None:
+        return False
+    offset = np.asarray(percept.position, dtype=np.float64)[:2] - anchor.recovery_at[:2]
+    extent = max(float(np.hypot(*anchor.size[:2])), float(np.hypot(*np.asarray(percept.size)[:2])))
+    return float(np.hypot(*offset)) > extent / 2.0 + RECOVERY_PLACE_SLACK
 
 
 def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleConfig) -> bool:

@@ -155,6 +155,7 @@ def apply_decision(
     kept.lost_at = merged.lost_at if still_missing else None
     kept.missed_frames = merged.missed_frames if still_missing else 0
     kept.recovery_sightings = merged.recovery_sightings if still_missing else 0
+    kept.recovery_at = merged.recovery_at if still_missing else None
     merged.state = AnchorState.FORGOTTEN
     index.refresh(kept)
     changes.forgotten.append(merged)

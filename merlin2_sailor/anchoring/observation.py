@@ -54,7 +54,7 @@ def reacquire(
     was_missing = anchor.state is AnchorState.MISSING
     missing_since = anchor.missing_since
     partial = partial or smaller_than_known(percept, anchor)
-    before_sighting(anchor, percept.stamp, lifecycle)
+    before_sighting(anchor, percept, lifecycle)
     # A MISSING anchor's sighting too few to bring it back is no evidence of what the object looks
     # like (it may be a false box, or a look-alike, in a searched disc): its colour and look join
     # the anchor only once it is back. Three false "dog" boxes around a book, each taken in a

@@ -14,6 +14,7 @@ from merlin2_sailor.anchoring import (
     Anchoring,
     AnchoringConfig,
     AnchorState,
+    Expectation,
     LifecycleConfig,
     MatchingTableConfig,
 )
@@ -23,6 +24,7 @@ from .anchoring_scenes import (
     KITCHEN,
     TWIN_MUGS,
     AppearanceRules,
+    PerceptMaker,
     SceneObject,
     camera_view,
     flat_depth,
@@ -164,6 +166,56 @@ def test_sightings_of_a_missing_anchor_far_apart_do_not_bring_it_back(make_ancho
     assert anchoring.get("cup_1").state is AnchorState.MISSING
     result = anchoring.process([maker.percept(cup, 4.0 + FRAME)], camera_view(), 4.0 + FRAME)
     assert AnchorEventKind.CONFIRMED in kinds(result) and anchoring.get("cup_1").state is AnchorState.CONFIRMED
+
+
+@pytest.mark.parametrize("with_look", [False, True])
+def test_a_searched_anchor_comes_back_only_by_sightings_of_one_place(make_anchoring, quick_lifecycle, maker,
+                                                                     kitchen, with_look):
+    """A search takes views of the class anywhere in its disc, so the sightings that bring a lost
+    anchor back must stand together: two views of the moved object and then a false box 2 m away,
+    frames apart, are not three sightings of one object (the lost bicycle came back on the kitchen
+    wall, `large_object_wheeled_away`, seed 0); three views of one place are, wherever that is."""
+    lifecycle = dataclasses.replace(quick_lifecycle, confirm_after=3, forget_after=600.0)
+    options = {"matcher": AppearanceRules()} if with_look else {}
+    anchoring = make_anchoring(AnchoringConfig(lifecycle=lifecycle), **options)
+    cup = kitchen["red_cup"]
+    for frame in range(4):
+        anchoring.process([maker.percept(cup, frame * FRAME)], camera_view(), frame * FRAME)
+    for frame in range(4, 8):
+        anchoring.process([], camera_view(), frame * FRAME)
+    lost = anchoring.get("cup_1")
+    assert lost.state is AnchorState.MISSING
+    centre = np.array(cup.position) + (0.5, 0.0, 0.0)
+    anchoring.expect("cup_1", Expectation.at(centre, 1.0, "kitchen", "find", radius=3.0))
+    moved_to = np.array(cup.position) + (0.6, 0.8, 0.0)
+    false_box = np.array(cup.position) + (0.6, -1.2, 0.0)
+    stamp = 1.0
+    for position in (moved_to, moved_to, false_box, moved_to):
+        result = anchoring.process([maker.percept(cup, stamp, position=position)], camera_view(), stamp)
+        assert result.percept_symbols == ("cup_1",), "the search takes each view in its disc"
+        assert lost.state is AnchorState.MISSING
+        stamp += FRAME
+    for _ in range(2):
+        anchoring.process([maker.percept(cup, stamp, position=moved_to)], camera_view(), stamp)
+        stamp += FRAME
+    assert lost.state is AnchorState.CONFIRMED
+    assert np.linalg.norm(lost.position[:2] - moved_to[:2]) < 0.5 < np.linalg.norm(lost.position[:2] - false_box[:2])
+
+
+@pytest.mark.parametrize("size", [(0.35, 1.6, 1.0), (0.1, 0.1, 0.12)])
+def test_views_of_one_object_on_its_way_back_stand_within_half_its_footprint_and_a_little(size):
+    """Parts of a bicycle seen end to end, or a mug's noisy views, are of one place; farther is another."""
+    from merlin2_sailor.anchoring.anchor import Anchor
+    from merlin2_sailor.anchoring.lifecycle import RECOVERY_PLACE_SLACK, recovery_moved
+
+    anchor = Anchor("x_1", "x", np.zeros(3), np.array(size), 0.0, 1.0, state=AnchorState.MISSING)
+    anchor.recovery_sightings, anchor.recovery_at = 1, np.zeros(3)
+    reach = math.hypot(size[0], size[1]) / 2.0 + RECOVERY_PLACE_SLACK
+    percept = PerceptMaker(seed=1).percept(SceneObject("x", "x", (0.0, 0.0, 0.0), size=size), 2.0)
+    assert not recovery_moved(anchor, dataclasses.replace(percept, position=np.array((0.0, reach * 0.9, 5.0))))
+    assert recovery_moved(anchor, dataclasses.replace(percept, position=np.array((reach * 1.1, 0.0, 0.0))))
+    anchor.recovery_sightings = 0  # the first sighting of a way back is judged by nothing before it
+    assert not recovery_moved(anchor, dataclasses.replace(percept, position=np.array((9.0, 0.0, 0.0))))
 
 
 @pytest.mark.parametrize("with_look", [False, True])
