@@ -38,7 +38,9 @@ blackboard), the robot searches for it:
 6. Found nowhere, with no candidate: the search still concludes (``conclude_search``) before it
    gives up, and the anchoring layer reports the sought anchor indistinguishable from anchors the
    search could not rule out, if any (of its colour, looking like it, possible by time and place):
-   the search then ends as in 4, "cannot be told from", rather than "not found".
+   the search then ends as in 4, "cannot be told from", rather than "not found". Where one anchor
+   alone is left in question and no copy of the sought one is anchored, the anchoring layer
+   reports it found by look alone instead, and the search goes to it and concludes as in 5.
 """
 
 from __future__ import annotations
@@ -303,9 +305,12 @@ def note_indistinguishable(context: BehaviorContext, search: Search, sought: Anc
     return True
 
 
-def note_look_alone(context: BehaviorContext, search: Search, sought: AnchorReport | None) -> None:
+def note_look_alone(context: BehaviorContext, search: Search, sought: AnchorReport | None,
+                    why: str = "where the camera had never looked before: a copy may have stood there all along; "
+                               "looking at the remaining stops before taking it") -> None:
     """Record the candidate the sought anchor reports found by look alone, and the waypoint nearest
-    it, once: the search goes on, since a copy may have stood there all along."""
+    it, once: the search goes on, since a copy may have stood there all along (``why``: what the
+    log line says of it)."""
     if sought is None or not sought.found_by_look_alone or sought.found_by_look_alone == search.look_alone:
         return
     search.look_alone = sought.found_by_look_alone
@@ -313,9 +318,7 @@ def note_look_alone(context: BehaviorContext, search: Search, sought: AnchorRepo
     search.look_alone_at = None if candidate is None else context.places.nearest_waypoint(
         candidate.position[0], candidate.position[1])
     where = search.look_alone_at or "an unknown place"
-    context.log("info", f"{search.symbol} looks like {search.look_alone} at {where}, "
-                        "where the camera had never looked before: a copy may have stood there all along; "
-                        "looking at the remaining stops before taking it")
+    context.log("info", f"{search.symbol} looks like {search.look_alone} at {where}, {why}")
 
 
 def plan_conclusion(state: BehaviorState, blackboard: Blackboard) -> str:
@@ -331,7 +334,12 @@ def plan_conclusion(state: BehaviorState, blackboard: Blackboard) -> str:
     note_look_alone(context, search, sought)
     if not search.look_alone:
         ask_what_is_left_in_question(context, search)
-        return EXHAUSTED
+        if search.indistinguishable_from:
+            return EXHAUSTED
+        sought = context.anchoring.get_anchor(search.symbol)
+        note_look_alone(context, search, sought, "the only anchor the search left in question")
+        if not search.look_alone:
+            return EXHAUSTED
     if sought is None or sought.found_by_look_alone != search.look_alone:
         context.log("info", f"{search.look_alone} is no longer taken for {search.symbol}: not concluding on it")
         return EXHAUSTED
@@ -357,7 +365,9 @@ def plan_conclusion(state: BehaviorState, blackboard: Blackboard) -> str:
 def ask_what_is_left_in_question(context: BehaviorContext, search: Search) -> None:
     """Found nowhere: before saying "not found", conclude the search with the anchoring layer, which
     reports the sought anchor indistinguishable from anchors the search could not rule out (of its
-    colour, looking like it, possible by time and place) rather than absent."""
+    colour, looking like it, possible by time and place) rather than absent, or, where one alone is
+    left in question and no copy of the sought one is anchored, reports it found by look alone (the
+    search then goes to it and concludes there)."""
     try:
         context.anchoring.conclude_search(search.symbol, FIND_SOURCE)
     except BehaviorError as error:

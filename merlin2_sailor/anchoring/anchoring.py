@@ -359,8 +359,11 @@ class Anchoring:
         """A search for ``symbol`` has looked everywhere: take the anchor it found by look alone
         where the camera had never watched (``found_by_look_alone``) for it, unless a copy of it is
         anchored by now (then AMBIGUOUS, naming them); without a candidate, AMBIGUOUS naming the
-        anchors the search left in question, if any. The result holds the merge's events (none:
-        nothing was taken; the anchor says why in ``indistinguishable_from``, or had no candidate)."""
+        anchors the search left in question, if any, or, where one alone is left in question and
+        no copy of the sought one is anchored, that one recorded as found by look alone (the
+        search concludes on it next). The result holds the merge's events (none: nothing was taken;
+        the anchor says why in ``indistinguishable_from``, or names its new candidate in
+        ``found_by_look_alone``, or had no candidate)."""
         anchor = self._require(symbol)
         when = self._latest_stamp if stamp is None else stamp
         changes = FrameChanges(when if math.isfinite(when) else 0.0)

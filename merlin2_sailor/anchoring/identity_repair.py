@@ -285,7 +285,8 @@ class IdentityRepair:
         (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
         of it is anchored by now (:class:`Undecided`) or the candidate is gone or no longer
         possible (None: nothing to take). Without a candidate, an :class:`Undecided` when the
-        search left anchors in question (:meth:`_left_in_question`)."""
+        search left anchors in question, or an :class:`Unconfirmed` (a candidate to conclude on)
+        when it left one alone and no copy (:meth:`_left_in_question`)."""
         if sought.state is not AnchorState.MISSING or sought.indistinguishable_from:
             return None
         found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
@@ -309,9 +310,13 @@ class IdentityRepair:
                              f"{', '.join(sorted(other.symbol for other in twins))}: it may be another copy")
         return Merge(sought, found, score, "found by search; no other copy anywhere searched", moved=True)
 
-    def _left_in_question(self, sought: Anchor, index: AnchorIndex) -> Undecided | None:
+    def _left_in_question(self, sought: Anchor, index: AnchorIndex) -> Undecided | Unconfirmed | None:
         """For a search that looked everywhere and found nothing: :class:`Undecided` naming the
-        anchors it leaves in question, else None ("not found" is then what the evidence says).
+        anchors it leaves in question, else None ("not found" is then what the evidence says). One
+        anchor alone in question, with no other copy of the sought one anywhere (no twin, as
+        :meth:`conclude_search` asks of a find by look alone) and the sought one not seen elsewhere
+        since it appeared, is a find by look alone (:class:`Unconfirmed`): the search goes to it
+        and concludes there, as with a candidate it found at a stop.
 
         An anchor is in question when it could have been carried where it stands since the sought
         object was lost, its colour agrees with the sought one's (both known), the matching
@@ -326,8 +331,9 @@ class IdentityRepair:
         found" though it stood in the disc (`moved_while_its_twin_is_watched`, network, seed 1,
         6 December 2026). Asked at each stop instead, the rule ended the search on a first far view
         (0.39) of the red mug moved to the bedroom, which closer views took for it (0.70):
-        `moved_to_the_far_room`, seed 2. Which object it is, the evidence cannot say; that it is
-        absent, the evidence does not say either."""
+        `moved_to_the_far_room`, seed 2. Which object it is, where several are in question or a
+        copy of the sought one is anchored, the evidence cannot say; that it is absent, the
+        evidence does not say either."""
         if self.firm_rejection <= 0.0:
             return None
         in_question: list[tuple[Anchor, float]] = []
@@ -341,6 +347,16 @@ class IdentityRepair:
                 in_question.append((candidate, searched))
         if not in_question:
             return None
+        if len(in_question) == 1:
+            [(candidate, searched)] = in_question
+            if not self._twins(sought, index, besides=candidate) and not self._seen_elsewhere(sought, candidate):
+                # The hedge is the network's, not the evidence's: the red mug moved beside the green
+                # one in a room never explored scored 0.45 in its disc (0.95 by everything but
+                # place), the only red mug in the house, and the search said it could not tell
+                # (`moved_beside_other_colour`, network, seed 0, 6 December 2026).
+                return Unconfirmed(sought, candidate, searched,
+                                   f"the only anchor the search left in question for {sought.symbol}, "
+                                   "of its colour and looking like it, and no other copy of it anywhere")
         in_question.sort(key=lambda pair: (-pair[1], pair[0].symbol))
         named = ", ".join(f"{candidate.symbol} ({score:.2f})" for candidate, score in in_question)
         return Undecided((sought,), tuple(candidate for candidate, _ in in_question),

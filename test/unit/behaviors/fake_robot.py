@@ -112,6 +112,9 @@ class FakeAnchoring:
     left_in_question: tuple[str, ...] = ()
     """What a search concluded with no candidate leaves in question: the anchoring layer then reports
     the sought anchor indistinguishable from these (empty: not found)."""
+    alone_in_question: str = ""
+    """What a search concluded with no candidate leaves alone in question, with no copy of the
+    sought anchor: the anchoring layer then reports it found by look alone (empty: none)."""
     _clock: itertools.count = field(default_factory=lambda: itertools.count(100))
 
     def add(self, symbol: str, class_name: str, position: tuple[float, float, float],
@@ -179,12 +182,16 @@ class FakeAnchoring:
     def conclude_search(self, symbol: str, source: str) -> bool:
         """Like the real one: the candidate found by look alone becomes the sought anchor (confirmed
         where the candidate is, seen now; the candidate's report is gone), unless a copy turned up;
-        with no candidate, the anchors ``left_in_question`` make the sought one indistinguishable."""
+        with no candidate, the anchors ``left_in_question`` make the sought one indistinguishable,
+        or the one ``alone_in_question`` becomes its candidate."""
         self._check()
         self.expectations.append(Expectation("conclude", symbol, (0.0, 0.0, 0.0), "", source))
         sought = self.anchors.get(symbol)
         if sought is not None and not sought.found_by_look_alone and self.left_in_question:
             self.report(symbol, indistinguishable_from=self.left_in_question)
+            return False
+        if sought is not None and not sought.found_by_look_alone and self.alone_in_question in self.anchors:
+            self.report(symbol, found_by_look_alone=self.alone_in_question)
             return False
         if (self.refuse_conclusions or sought is None or sought.indistinguishable_from
                 or sought.found_by_look_alone not in self.anchors):

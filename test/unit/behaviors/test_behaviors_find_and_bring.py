@@ -108,6 +108,26 @@ def test_find_that_finds_nothing_but_leaves_a_look_alike_in_question_ends_unable
     assert FOUND_SYMBOL_KEY not in blackboard
 
 
+def test_find_that_finds_nothing_but_leaves_one_look_alike_alone_in_question_goes_to_it_and_takes_it(
+    robot: FakeRobot,
+) -> None:
+    """Concluded with no candidate, the anchoring layer reports the one anchor left in question (no
+    copy of the sought one anchored) found by look alone: the search goes to it, concludes there and
+    ends found, rather than "cannot be told from"."""
+    x, y = WAYPOINTS["d"]
+    robot.anchoring.add("cup_9", "cup", (x + 0.3, y + 0.4, 0.8))
+    robot.anchoring.alone_in_question = "cup_9"
+    outcome, blackboard = find(robot, "cup_1", "a")
+    assert outcome == SUCCEED, blackboard
+    assert stops(robot) == [*TOUR, "d"]  # every stop, then to the candidate
+    kinds = [e.kind for e in robot.anchoring.expectations]
+    assert kinds.count("conclude") == 2 and kinds[-1] == "conclude"
+    assert blackboard[FOUND_SYMBOL_KEY] == "cup_1" and blackboard[FOUND_AT_KEY] == "d"
+    assert "cup_9" not in robot.anchoring.anchors
+    noted = [message for _, message in robot.logs if "cup_1 looks like cup_9" in message]
+    assert len(noted) == 1 and "the only anchor the search left in question" in noted[0]
+
+
 def test_find_that_finds_only_look_alikes_it_cannot_tell_apart_ends_unsuccessful_saying_so(
     robot: FakeRobot,
 ) -> None:
