@@ -168,6 +168,18 @@ def test_sightings_of_a_missing_anchor_far_apart_do_not_bring_it_back(make_ancho
     assert AnchorEventKind.CONFIRMED in kinds(result) and anchoring.get("cup_1").state is AnchorState.CONFIRMED
 
 
+def seen_then_lost(anchoring, maker, item, seen_frames: int):
+    """``item`` seen for ``seen_frames`` frames, then looked at and not there until frame 8: its
+    anchor (the first of its class), MISSING."""
+    for frame in range(seen_frames):
+        anchoring.process([maker.percept(item, frame * FRAME)], camera_view(), frame * FRAME)
+    for frame in range(seen_frames, 8):
+        anchoring.process([], camera_view(), frame * FRAME)
+    lost = anchoring.get(f"{item.class_name}_1")
+    assert lost.state is AnchorState.MISSING
+    return lost
+
+
 @pytest.mark.parametrize("with_look", [False, True])
 def test_a_searched_anchor_comes_back_only_by_sightings_of_one_place(make_anchoring, quick_lifecycle, maker,
                                                                      kitchen, with_look):
@@ -179,12 +191,7 @@ def test_a_searched_anchor_comes_back_only_by_sightings_of_one_place(make_anchor
     options = {"matcher": AppearanceRules()} if with_look else {}
     anchoring = make_anchoring(AnchoringConfig(lifecycle=lifecycle), **options)
     cup = kitchen["red_cup"]
-    for frame in range(4):
-        anchoring.process([maker.percept(cup, frame * FRAME)], camera_view(), frame * FRAME)
-    for frame in range(4, 8):
-        anchoring.process([], camera_view(), frame * FRAME)
-    lost = anchoring.get("cup_1")
-    assert lost.state is AnchorState.MISSING
+    lost = seen_then_lost(anchoring, maker, cup, seen_frames=4)
     centre = np.array(cup.position) + (0.5, 0.0, 0.0)
     anchoring.expect("cup_1", Expectation.at(centre, 1.0, "kitchen", "find", radius=3.0))
     moved_to = np.array(cup.position) + (0.6, 0.8, 0.0)
@@ -230,12 +237,7 @@ def test_a_missing_anchors_sightings_that_do_not_bring_it_back_change_nothing_of
     options = {"matcher": AppearanceRules()} if with_look else {}
     anchoring = make_anchoring(AnchoringConfig(lifecycle=lifecycle), **options)  # confirm_after = 2
     cup = dataclasses.replace(kitchen["red_cup"], colour=mug_colour(0))
-    for frame in range(3):
-        anchoring.process([maker.percept(cup, frame * FRAME)], camera_view(), frame * FRAME)
-    for frame in range(3, 8):
-        anchoring.process([], camera_view(), frame * FRAME)
-    lost = anchoring.get("cup_1")
-    assert lost.state is AnchorState.MISSING
+    lost = seen_then_lost(anchoring, maker, cup, seen_frames=3)
     colour_views, colour_seen = lost.colour.views, lost.colour_seen
     gallery = None if lost.gallery is None else len(lost.gallery)
     turned_away = camera_view(yaw=math.pi)
