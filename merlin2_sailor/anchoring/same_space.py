@@ -64,17 +64,13 @@ class Duplicate:
     overlap: float
     reason: str
     score: float | None = None
+    what: str = "a second anchor of its object"
+    """What the duplicate was, for the FORGOTTEN event."""
 
     @property
     def explanation(self) -> str:
         """What the FORGOTTEN event says of it."""
-        if self.reason.startswith(ACROSS):
-            return f"{self.reason}: not an object of its own"
-        return f"{self.reason}: a second anchor of its object"
-
-
-#: How the reason of a :class:`Duplicate` drawn across two objects begins.
-ACROSS = "a box across"
+        return f"{self.reason}: {self.what}"
 
 
 def shared_volume(first: Anchor, second: Anchor) -> float:
@@ -145,7 +141,8 @@ def _boxes_across(
         first, second = pairs[0]
         overlap = next(share for share, anchor in held if anchor is first)
         duplicates.append(Duplicate(first, missing[symbol], overlap,
-                                    f"{ACROSS} {first.symbol} and {second.symbol}, which fill its space"))
+                                    f"a box across {first.symbol} and {second.symbol}, which fill its space",
+                                    what="not an object of its own"))
         settled.add(symbol)
     return duplicates
 
