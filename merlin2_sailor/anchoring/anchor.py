@@ -104,6 +104,11 @@ class Anchor:
     times_seen: int = 1
     whole_views: int = 0
     """Sightings that showed the whole object (not cut by the image's edge or an occluder)."""
+    last_placed: float | None = None
+    """The stamp of its latest sighting that placed it (None: as ``last_seen``, for anchors restored
+    from older snapshots): a whole view, or any view before its first whole one. A part of the
+    object, once it has had a whole view, keeps it alive without moving it (:meth:`absorb`), so the
+    place it is at was seen then: what losing it records (:func:`.lifecycle.after_expected_but_unseen`)."""
     last_tracker_id: str = ""
     """The tracker id of the latest percept that carried one; empty when none ever did."""
     class_votes: dict[str, float] = field(default_factory=dict)
@@ -151,8 +156,9 @@ class Anchor:
     :func:`.lifecycle.before_sighting`). Not persisted: it matters for seconds."""
     missing_since: float | None = None
     lost_after: float | None = None
-    """While MISSING: its last sighting before it went missing (later sightings while missing,
-    too few to bring it back, do not count): an anchor born after it may be the object, moved."""
+    """While MISSING: its last sighting that placed it (:attr:`last_placed`) before it went missing
+    (later sightings while missing, too few to bring it back, do not count; nor do parts of it that
+    did not move it): an anchor born after it may be the object, moved."""
     lost_at: np.ndarray | None = None
     """While MISSING: where that sighting (``lost_after``) perceived it; a sighting while missing
     moves ``perceived_position`` but not this (:meth:`.IdentityRepair._could_have_been_carried`)."""
@@ -216,6 +222,11 @@ class Anchor:
             sure = min(sure, unverified[0])
         return sure
 
+    @property
+    def place_seen(self) -> float:
+        """When its place was last seen: :attr:`last_placed`, or its last sighting where that is unknown."""
+        return self.last_seen if self.last_placed is None else self.last_placed
+
     def doubt_unverified(self, stamp: float) -> None:
         """A view at ``stamp`` whose colour cannot be held to its own reacquires it while its colour
         has gone unchecked: the view may be of another object in its place. A book of another colour,
@@ -261,6 +272,7 @@ class Anchor:
             size=np.array(percept.size, dtype=np.float64),
             first_seen=percept.stamp,
             last_seen=percept.stamp,
+            last_placed=percept.stamp,
             last_tracker_id=percept.tracker_id,
             class_votes=vote_class({}, percept.class_name, percept.score),
             position_variance=config.initial_variance * (config.partial_view_variance_factor if partial else 1.0),
@@ -304,6 +316,7 @@ class Anchor:
         if partial and self.parts_fit is not None and perceived:
             self._widen_to(percept)
         if moves:
+            self.last_placed = percept.stamp if self.last_placed is None else max(self.last_placed, percept.stamp)
             self.position, self.position_variance = fuse_position(
                 self.position, self.position_variance, percept.position, percept.stamp - self.last_seen, config,
                 partial,
@@ -360,6 +373,7 @@ class Anchor:
             self.size = other.size.copy()
             self.whole_views = other.whole_views if moved else self.whole_views + other.whole_views
             self.parts_fit = other.parts_fit
+            self.last_placed = (other.place_seen if moved else max(self.place_seen, other.place_seen))
         for class_name, votes in other.class_votes.items():
             self.class_votes[class_name] = self.class_votes.get(class_name, 0.0) + votes
         self.class_name = winning_class(self.class_votes, self.class_name)

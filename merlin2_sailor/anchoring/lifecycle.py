@@ -177,7 +177,13 @@ def after_expected_but_unseen(anchor: Anchor, stamp: float, config: LifecycleCon
     if anchor.state is AnchorState.TENTATIVE:
         return False
     anchor.state = AnchorState.MISSING
-    anchor.lost_after = anchor.last_seen
+    # Lost after the sighting that last placed it, where it is lost at: a part of it seen since (a
+    # box cut by the image's edge) kept it alive without moving it, and says too little of what was
+    # there to rule out that the object had gone. The bicycle's anchor in the bedroom took such a
+    # view 19 s after the bicycle, wheeled into the living room, was anchored anew there: counted
+    # as its last sighting, the two "stood together" and the search for it found nothing
+    # (scenario suite, `large_object_wheeled_away`, network, seed 1, 6 December 2026).
+    anchor.lost_after = anchor.place_seen
     anchor.lost_at = anchor.perceived_position.copy()
     return True
 

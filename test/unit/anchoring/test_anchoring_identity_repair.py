@@ -345,6 +345,40 @@ def test_a_bad_carry_speed_is_refused(value):
         RepairConfig(carry_speed=value)
 
 
+@pytest.mark.parametrize(("view", "found"), [("cut by the image's edge", "cup_2"), ("whole", "")])
+def test_a_part_seen_at_the_old_place_after_the_object_was_anchored_elsewhere_does_not_rule_it_out(
+        anchoring, maker, view, found):
+    """The mug, carried to the living room, is anchored anew there; 2 s later, the robot's camera,
+    back in the kitchen, sees a mug's box at its old place, cut by the image's edge: it keeps the
+    kitchen anchor alive but does not place it (:meth:`.Anchor.absorb`), and the anchor is lost
+    at the next frame. Its loss is dated from the sighting that last placed it, so the living
+    room's newcomer, born after that, may still be it, and the search finds it (scenario suite,
+    `large_object_wheeled_away`, network, seed 1, 6 December 2026: the bicycle's anchor took such a
+    view 19 s after the wheeled bicycle was anchored anew; the two "stood together", and the
+    search found nothing). A whole view there is the mug seen in both places at once, as before:
+    the newcomer is another mug."""
+    from .test_anchoring_partial_views import EDGE_BOX, MIDDLE_BOX
+    seen_twice(anchoring, maker, [KITCHEN_MUG], 0.0)
+    seen_twice(anchoring, maker, [KITCHEN_MUG], WALKED_THERE, camera=False, positions={"blue_mug": LIVING_ROOM})
+    assert [anchor.state for anchor in anchoring.anchors] == [AnchorState.CONFIRMED] * 2
+    box = EDGE_BOX if view != "whole" else MIDDLE_BOX
+    part = dataclasses.replace(maker.percept(KITCHEN_MUG, WALKED_THERE + 2.0), box=box)
+    anchoring.process([part], camera_view(), WALKED_THERE + 2.0)
+    assert anchoring.get("cup_1").last_seen == WALKED_THERE + 2.0 and len(anchoring) == 2  # it took the view
+    see(anchoring, maker, [], WALKED_THERE + 2.5)
+    lost = anchoring.get("cup_1")
+    assert lost.state is AnchorState.MISSING
+    assert lost.lost_after == (FRAME if view != "whole" else WALKED_THERE + 2.0)
+    from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
+    assert anchor_from_dict(anchor_to_dict(lost)).last_placed == lost.last_placed  # kept over a restart
+    assert search_living_room(anchoring, "cup_1", WALKED_THERE + 3.0).events == ()
+    assert recorded(anchoring, "cup_1") == (AnchorState.MISSING, found)
+    assert concluded(anchoring, "cup_1") == (
+        [(AnchorEventKind.FORGOTTEN, "cup_2"), (AnchorEventKind.CONFIRMED, "cup_1")] if found else [])
+    if found:  # placed, now, where the newcomer saw it
+        assert anchoring.get("cup_1").last_placed == pytest.approx(WALKED_THERE + FRAME)
+
+
 def test_the_bound_measures_from_where_the_lost_object_was_last_seen_before_it_went_missing(maker):
     """A sighting while missing (too few to bring the anchor back; a false detection on the way,
     probe scenario, seed 8) moves the anchor's perceived position, not the place its object was
