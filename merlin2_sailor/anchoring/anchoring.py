@@ -37,7 +37,7 @@ from merlin2_sailor.anchoring.events import AnchorEvent, AnchorEventKind
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.far_view import FarViewConfig, nearest_anchor, unresolved_far_views
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
-from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, register_frame, shift_percepts
+from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, read_frame, shift_percepts
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig, Unconfirmed
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, sightings_doubled
@@ -223,8 +223,16 @@ class Anchoring:
                                                                               self.config.partial_view)
         # Unless something says which views are whole, no single view is colour evidence.
         whole = None if camera is None and not told else [not flag for flag in partial]
-        # The pose error all of this frame's percepts share is taken out before anything is judged.
-        frame_offset = register_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
+        # The pose error all of this frame's percepts share is taken out before anything is judged;
+        # views of a row that sits off its anchors by an error read two ways are held out.
+        reading = read_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
+        frame_offset = reading.offset
+        held = set(reading.held)
+        frame_rows = [row for row in range(len(percepts)) if row not in held]
+        if reading.held:
+            percepts = [percepts[row] for row in frame_rows]
+            partial = [partial[row] for row in frame_rows]
+            whole = None if whole is None else [whole[row] for row in frame_rows]
         percepts = shift_percepts(percepts, frame_offset)
         table = self._table_builder.build(percepts, self._index, whole)
         for anchor in table.disputed:
@@ -282,7 +290,7 @@ class Anchoring:
         seen = set(symbols)
         if camera is not None:
             # An anchor a far view may have been is not unseen: whether it was there cannot be told.
-            told_apart = seen | {anchor.symbol for anchor in unresolved.values()}
+            told_apart = seen | {anchor.symbol for anchor in unresolved.values()} | set(reading.landmarks)
             check_unseen(self._index, camera, told_apart, changes, config.visibility, config.lifecycle)
         note_seen_together((anchor for anchor in map(self._index.get, seen) if anchor is not None), self._index)
         renamed = self._repair_identities(changes)
@@ -294,7 +302,12 @@ class Anchoring:
             if anchor.symbol not in seen:
                 anchor.visible = False
         may_be = tuple(renamed.get(anchor.symbol, anchor.symbol) for anchor in unresolved.values())
-        return changes.result(symbols, may_be, frame_offset)
+        if reading.held:
+            every_row = [""] * (len(frame_rows) + len(reading.held))
+            for row, symbol in zip(frame_rows, symbols, strict=True):
+                every_row[row] = symbol
+            symbols = every_row
+        return changes.result(symbols, may_be, frame_offset, reading.held)
 
     def track(self, stamp: float, robot_pose: Pose | None = None) -> AnchoringResult:
         """Extend anchors without observation and apply the lifecycle's time-outs.

@@ -17,7 +17,9 @@ class AnchoringResult:
     for a percept left unresolved (too far to tell, :mod:`.far_view`; or held apart by a first view
     of another colour, :mod:`.colour_evidence`); ``unresolved`` names, per such percept, the
     anchor it may have been; ``frame_offset``: the shared pose error taken out of the frame's
-    percepts before matching (:mod:`.frame_registration`), None when none was."""
+    percepts before matching (:mod:`.frame_registration`), None when none was; ``held``: the
+    percepts (indices) held out of matching, views of a row off its anchors by a pose error that
+    could be read two ways (:func:`.frame_registration.read_frame`; their symbols are "")."""
 
     stamp: float
     acquired: tuple[Anchor, ...] = ()
@@ -28,6 +30,7 @@ class AnchoringResult:
     percept_symbols: tuple[str, ...] = ()
     unresolved: tuple[str, ...] = ()
     frame_offset: FrameOffset | None = None
+    held: tuple[int, ...] = ()
 
 
 @dataclass(slots=True)
@@ -52,7 +55,7 @@ class FrameChanges:
 
     def result(
         self, percept_symbols: Sequence[str] = (), unresolved: Sequence[str] = (),
-        frame_offset: FrameOffset | None = None,
+        frame_offset: FrameOffset | None = None, held: Sequence[int] = (),
     ) -> AnchoringResult:
         return AnchoringResult(
             self.stamp,
@@ -64,4 +67,5 @@ class FrameChanges:
             tuple(percept_symbols),
             tuple(unresolved),
             frame_offset,
+            tuple(held),
         )

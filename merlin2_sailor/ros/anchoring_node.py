@@ -132,6 +132,7 @@ class AnchoringNode(Node):
         self._reported_embedding = (0, 0)
         self._unresolved: Counter[str] = Counter()  # anchor -> views not yet told from it, this period
         self._offsets: list[float] = []  # pose errors (m) taken out of frames this period
+        self._held_frames = 0  # frames this period whose views of a row were held out (read two ways)
         self.create_timer(DROP_REPORT_PERIOD_SECONDS, self._report)
 
         self.service.start()
@@ -216,14 +217,19 @@ class AnchoringNode(Node):
                                "until a closer or a second view")
 
     def _report_offsets(self) -> None:
-        """Frames whose shared pose error was taken out in the last period (frame_registration):
-        many, or large ones, say the robot's localisation drifts."""
-        if not self._offsets:
-            return
+        """Frames seen off their anchors by a shared pose error in the last period
+        (frame_registration): taken out, or, where it could be read two ways, their views of the
+        row held out. Many, or large ones, say the robot's localisation drifts."""
         offsets, self._offsets = self._offsets, []
-        self.get_logger().info(
-            f"{len(offsets)} frame(s) in the last {DROP_REPORT_PERIOD_SECONDS:g} s were seen off their anchors by "
-            f"one shared pose error (up to {max(offsets):.2f} m), taken out before matching")
+        held, self._held_frames = self._held_frames, 0
+        if offsets:
+            self.get_logger().info(
+                f"{len(offsets)} frame(s) in the last {DROP_REPORT_PERIOD_SECONDS:g} s were seen off their anchors by "
+                f"one shared pose error (up to {max(offsets):.2f} m), taken out before matching")
+        if held:
+            self.get_logger().info(
+                f"{held} frame(s) in the last {DROP_REPORT_PERIOD_SECONDS:g} s were seen off their anchors by a pose "
+                "error that could be read two ways (a row of look-alikes): their views of the row were held out")
 
     def _report_embedding(self) -> None:
         """How many crops the last period embedded, and how many took a recent crop's embedding."""
@@ -257,8 +263,9 @@ class AnchoringNode(Node):
                                       throttle_duration_sec=5.0)
             return
         self._unresolved.update(result.unresolved)
-        if result.frame_offset is not None:
+        if result.frame_offset is not None and result.frame_offset.off_anchors:
             self._offsets.append(result.frame_offset.distance)
+        self._held_frames += bool(result.held)
         self._publish(result)
 
     def _refuse_future_stamps(self, stamp: float, message: PerceptArray) -> None:
