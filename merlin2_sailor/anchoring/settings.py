@@ -453,7 +453,9 @@ SETTINGS: tuple[Setting, ...] = (
                 "count for an offset.", 0.0, 1.0),
         Setting("registration_minimum_support", ("core", "registration", "minimum_support"),
                 "How many percepts an offset must put on anchors to be applied (it must also put more "
-                "there than no offset does, and more than twice as many as any rival offset).", 2, 1000),
+                "there than no offset does, and more than twice as many as any rival offset; where no "
+                "offset puts more there than none, the error those views share is taken out; a frame "
+                "off its anchors that reads two ways has those views held out of matching).", 2, 1000),
         Setting("registration_minimum_views", ("core", "registration", "minimum_views"),
                 "How many times an anchor must have been seen to serve as a landmark for the offset.", 1, 1000000),
     ),
