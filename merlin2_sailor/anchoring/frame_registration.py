@@ -178,15 +178,6 @@ def read_frame(
     return FrameReading(held=tuple(held), landmarks=tuple(landmarks))
 
 
-def register_frame(
-    percepts: Sequence[Percept], index: AnchorIndex, config: RegistrationConfig, whole: Sequence[bool] | None = None,
-    colour: ColourEvidenceConfig | None = None,
-) -> FrameOffset | None:
-    """The offset that puts the frame's percepts on the anchors, or None when none is justified
-    (:func:`read_frame`)."""
-    return read_frame(percepts, index, config, whole, colour).offset
-
-
 def shift_percepts(percepts: Sequence[Percept], frame_offset: FrameOffset | None) -> tuple[Percept, ...]:
     """The percepts with ``frame_offset`` added to their positions (as they are for None)."""
     if frame_offset is None:

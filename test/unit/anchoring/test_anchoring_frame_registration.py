@@ -12,7 +12,7 @@ import pytest
 from merlin2_sailor.anchoring import AnchoringConfig, AnchorState
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, read_frame, register_frame, shift_percepts
+from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, read_frame, shift_percepts
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.errors import ConfigurationError
 
@@ -28,6 +28,11 @@ def shelf(covers: tuple[int | None, ...] = COVERS) -> list[SceneObject]:
     return [SceneObject(f"book_{i}", "book", (3.0, (i - 3) * SPACING, 1.0), (0.04, 0.16, 0.24),
                         colour=None if cover is None else mug_colour(cover, share=0.6))
             for i, cover in enumerate(covers)]
+
+
+def register_frame(*args, **options):
+    """The offset the frame reading takes out (None: none)."""
+    return read_frame(*args, **options).offset
 
 
 def settled_index(books: list[SceneObject], maker: PerceptMaker, views: int = 6) -> AnchorIndex:
