@@ -33,7 +33,9 @@ backbone on both crops: cost grew with every anchor ever seen, near or far. Here
    (:func:`~.colour_evidence.sized_view_differs`) and a first such view a moment earlier did too;
    that first view is only held apart from the anchor (``held``). A view is whole *for an anchor*
    as appearance takes it (:func:`.partial_view.comparable_views`): a view showing clearly less of
-   a large object than the anchor's whole views did has a part's colour, not the object's.
+   a large object than the anchor's whole views did has a part's colour, not the object's; and
+   only where the view and the anchor's views show about as much of a large object's height and
+   footprint, whichever saw less (:func:`.partial_view.colour_comparable_views`).
    A view anywhere in the disc of a search for an anchor (which the table counts as in place)
    is gated from it when its colour differs from the anchor's mean over all its views, as a
    search's merge of two anchors asks (:func:`~.colour_evidence.view_differs`): a white mug 2 m
@@ -63,7 +65,7 @@ from merlin2_sailor.anchoring.colour_evidence import (
 )
 from merlin2_sailor.anchoring.features import AnchorColumns, PerceptColumns, extent_slack, pair_features
 from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.partial_view import comparable_views
+from merlin2_sailor.anchoring.partial_view import colour_comparable_views, comparable_views
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.errors import ConfigurationError
 
@@ -261,7 +263,9 @@ class MatchingTableBuilder:
             # of a bicycle's 1.68 m) showed another colour than the whole bicycle's views and ruled
             # its anchor out, one object under two symbols (scenario suite, `twin_moved`, network,
             # seed 0, 5 December 2026).
-            whole_for = comparable if comparable is not None else comparable_views(columns.sizes, whole, anchors)
+            # Nor is a view held to an anchor that saw more or less of the object's height or length
+            # than it did (:func:`.partial_view.colour_comparable_views`).
+            whole_for = colour_comparable_views(columns.sizes, whole, anchors)
             ruled_out, differing, held, colour_gaps = self._ruled_out_by_colour(percepts, anchors, whole_for, ~gated)
             apart = ruled_out | held
             scores[apart] = self.config.gated_score

@@ -618,6 +618,42 @@ def test_a_part_of_a_large_object_is_no_colour_evidence_against_it(class_name, s
     assert result.percept_symbols == (f"{class_name}_2",)
 
 
+@pytest.mark.parametrize(("class_name", "known", "seen", "own", "other"), [
+    # A dog's lower part hidden behind a sofa: the view shows 0.40 m of its 0.52 m.
+    ("dog", (0.56, 0.25, 0.52), (0.56, 0.25, 0.40), RED, GREEN),
+    # The anchor first knew only the top of a cat (its legs hidden), then the whole cat is seen.
+    ("cat", (0.47, 0.2, 0.22), (0.47, 0.2, 0.32), BLUE, 3),
+    # A horse first seen end-on, 0.6 m of its 1.4 m; then seen whole, side on.
+    ("horse", (0.6, 0.5, 1.5), (1.4, 0.5, 1.5), GREEN, RED),
+    # A television whose lower fifth and more is behind a cabinet.
+    ("tv", (1.1, 0.1, 0.65), (1.1, 0.1, 0.48), 16, BLUE),
+])
+def test_a_view_showing_more_or_less_of_a_large_objects_height_or_length_is_no_colour_evidence(
+        class_name, known, seen, own, other) -> None:
+    """A large object's view and its anchor that saw different amounts of it (a part hidden
+    behind furniture, or seen end-on, which neither the image's edge nor an occluder beside the
+    box tells) show the colours of different parts: whichever of the two saw less, the view is no
+    evidence that another object stands there (scenario suite, network, 6 December 2026: three
+    duplicate anchors of the dog, each from a view ruled out by colour where one side had seen
+    0.7-0.8 of the dog's height, or 0.6 of its length). The same colours at the extent the anchor
+    knows still rule it out."""
+    first = SceneObject(class_name, class_name, KITCHEN, size=known, colour=mug_colour(own))
+    differently_seen = SceneObject(class_name, class_name, KITCHEN, size=seen, colour=mug_colour(other))
+    anchoring, maker = rules(), PerceptMaker(seed=own + 3 * other)
+    see(anchoring, maker, [first], 0.0)
+    anchor = anchoring.get(f"{class_name}_1")
+    assert anchor.colour.views >= ColourEvidenceConfig().minimum_views
+    result = see(anchoring, maker, [differently_seen], 60.0, frames=SUSPICION_FRAMES + 3)
+    assert result.percept_symbols == (f"{class_name}_1",)
+    assert not anchor.colour_disputed and anchor.colour_suspected is None
+    assert [a.symbol for a in anchoring.anchors] == [f"{class_name}_1"]
+    another = SceneObject("another", class_name, KITCHEN, size=known, colour=mug_colour(other))
+    anchoring, maker = rules(), PerceptMaker(seed=own + 3 * other)
+    see(anchoring, maker, [first], 0.0)
+    result = see(anchoring, maker, [another], 60.0, frames=SUSPICION_FRAMES + 3)
+    assert result.percept_symbols == (f"{class_name}_2",)
+
+
 def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it() -> None:
     red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
     green = SceneObject("green", "cup", KITCHEN, colour=mug_colour(GREEN))
