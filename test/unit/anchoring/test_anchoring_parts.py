@@ -108,6 +108,33 @@ def test_a_box_joined_from_parts_takes_a_larger_piece_and_keeps_only_the_larger_
     assert joined.parts_fit is None and joined.whole_views == 3  # the larger piece's, seen whole
 
 
+@pytest.mark.parametrize(("whole_y", "whole_length", "part_y", "expected"), [
+    # The wheeled bicycle's near end, seen from the hall with nothing cut: 1.23 m of 1.6, centred
+    # 0.5 m short of the middle; then its far end (scenario suite, seed 1, 6 December 2026).
+    (4.64, 1.23, 5.76, (4.025, 5.985)),
+    # The same the other way round, the far end seen first and long.
+    (6.0, 1.1, 5.0, (4.775, 6.55)),
+    # A part inside the whole one's box is noise of it: the whole box stays.
+    (4.64, 1.23, 4.9, (4.025, 5.255)),
+])
+def test_a_part_beyond_a_whole_ones_box_widens_it_to_the_box_around_both(whole_y, whole_length, part_y, expected):
+    """A view over ``PARTIAL_FOOTPRINT_SHARE`` of the whole one's footprint is no part, yet may
+    miss a quarter of the object: a part of the object seen beyond its box shows the object reaches
+    there. The joined anchor then holds the box around both, as a box of parts."""
+    longer = bicycle("bicycle_2", whole_y, np.array((0.38, whole_length, 0.95)), first_seen=10.0, whole_views=8)
+    part = bicycle("bicycle_3", part_y, np.array((0.35, 0.45, 1.0)), first_seen=20.0)
+    [parts] = decide(seen_whole_elsewhere(), longer, part)
+    index = AnchorIndex()
+    for anchor in (longer, part):
+        index.add(anchor)
+    join_parts(parts, index, FrameChanges(30.0), AnchoringConfig().fusion)
+    low, high = longer.position - longer.size / 2, longer.position + longer.size / 2
+    assert (low[1], high[1]) == pytest.approx(expected)
+    assert "bicycle_3" not in index and longer.state is AnchorState.CONFIRMED
+    assert (longer.parts_fit is None) == (expected == pytest.approx((whole_y - whole_length / 2,
+                                                                     whole_y + whole_length / 2)))
+
+
 @pytest.mark.parametrize(
     "second, why",
     [
