@@ -623,6 +623,9 @@ def test_a_part_of_a_large_object_is_no_colour_evidence_against_it(class_name, s
     ("dog", (0.56, 0.25, 0.52), (0.56, 0.25, 0.40), RED, GREEN),
     # The anchor first knew only the top of a cat (its legs hidden), then the whole cat is seen.
     ("cat", (0.47, 0.2, 0.22), (0.47, 0.2, 0.32), BLUE, 3),
+    # A dog first seen end-on, 0.27 m of its 0.55 m (a small anchor, by its own extent), then side on
+    # (`large_object_wheeled_away`, network, seed 2, 7 December 2026).
+    ("dog", (0.27, 0.22, 0.52), (0.55, 0.3, 0.52), 9, 14),
     # A horse first seen end-on, 0.6 m of its 1.4 m; then seen whole, side on.
     ("horse", (0.6, 0.5, 1.5), (1.4, 0.5, 1.5), GREEN, RED),
     # A television whose lower fifth and more is behind a cabinet.
