@@ -46,10 +46,8 @@ from merlin2_sailor.anchoring.colour_evidence import (
     sector_centre,
     size_band,
 )
-from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.tour import Tour, TourConfig
-from merlin2_sailor_demos.world.world import World
+from merlin2_sailor_demos.identity.whole_views import whole_views_of_house
 
 TOUR_RATE_HZ = 3.0
 
@@ -59,26 +57,20 @@ Side = tuple[int, int]
 
 def sides_of_objects(house: int, source: HouseSource) -> dict[str, dict[Side, ColourModel]]:
     """Per object ("house/id/class") of held-out house ``house``: its whole views' colours by side."""
-    description, seed = source.house("test", house)
-    world = World(description, seed=seed, segment=True, darknet_data=source.darknet_data)
     sides: dict[str, dict[Side, ColourModel]] = defaultdict(dict)
-    for frame in Tour(world, TourConfig(rate_hz=TOUR_RATE_HZ)).frames():
-        partial = partial_views(frame.percepts, frame.camera, PartialViewConfig())
-        camera = np.asarray(frame.camera.position, dtype=np.float64)
-        for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
-            if object_id is None or cut or percept.colour is None:
-                continue
-            dx, dy = camera[0] - percept.position[0], camera[1] - percept.position[1]
-            sector = bearing_sector(math.atan2(dy, dx))
-            size = view_scale(percept)
-            if sector is None or not (math.isfinite(size) and size > 0.0):
-                continue
-            key = (size_band(size), sector)
-            groups = sides[f"{house}/{object_id}/{percept.class_name}"]
-            if key in groups:
-                groups[key].add(np.asarray(percept.colour, dtype=np.float64))
-            else:
-                groups[key] = ColourModel.of(np.asarray(percept.colour, dtype=np.float64))
+    for view in whole_views_of_house(house, source, TOUR_RATE_HZ):
+        percept, camera = view.percept, view.camera
+        dx, dy = camera[0] - percept.position[0], camera[1] - percept.position[1]
+        sector = bearing_sector(math.atan2(dy, dx))
+        size = view_scale(percept)
+        if sector is None or not (math.isfinite(size) and size > 0.0):
+            continue
+        key = (size_band(size), sector)
+        groups = sides[view.key]
+        if key in groups:
+            groups[key].add(np.asarray(percept.colour, dtype=np.float64))
+        else:
+            groups[key] = ColourModel.of(np.asarray(percept.colour, dtype=np.float64))
     return sides
 
 

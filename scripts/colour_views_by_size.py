@@ -32,10 +32,9 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import view_scale
 from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenceConfig, ColourModel, view_differs
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
-from merlin2_sailor.anchoring.partial_view import PARTIAL_FOOTPRINT_SHARE, PartialViewConfig, partial_views
+from merlin2_sailor.anchoring.partial_view import PARTIAL_FOOTPRINT_SHARE
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.tour import Tour, TourConfig
-from merlin2_sailor_demos.world.world import World
+from merlin2_sailor_demos.identity.whole_views import whole_views_of_house
 
 #: Frames per second of the tours: enough to see every object from each stop, cheap to render.
 TOUR_RATE_HZ = 3.0
@@ -52,16 +51,11 @@ class ColourView:
 
 def whole_views(house: int, source: HouseSource) -> dict[str, list[ColourView]]:
     """Every whole view with a colour of each object of held-out house ``house``, in time order."""
-    description, seed = source.house("test", house)
-    world = World(description, seed=seed, segment=True, darknet_data=source.darknet_data)
     views: dict[str, list[ColourView]] = defaultdict(list)
-    for frame in Tour(world, TourConfig(rate_hz=TOUR_RATE_HZ)).frames():
-        partial = partial_views(frame.percepts, frame.camera, PartialViewConfig())
-        for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
-            if object_id is not None and not cut and percept.colour is not None:
-                views[f"{house}/{object_id}/{percept.class_name}"].append(
-                    ColourView(frame.stamp, np.asarray(percept.colour, dtype=np.float64), view_scale(percept),
-                               float(np.max(percept.size[:2]))))
+    for view in whole_views_of_house(house, source, TOUR_RATE_HZ):
+        percept = view.percept
+        views[view.key].append(ColourView(view.stamp, np.asarray(percept.colour, dtype=np.float64),
+                                          view_scale(percept), float(np.max(percept.size[:2]))))
     return views
 
 

@@ -35,10 +35,8 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import view_scale
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs, with_sized_view
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
-from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.tour import Tour, TourConfig
-from merlin2_sailor_demos.world.world import World
+from merlin2_sailor_demos.identity.whole_views import whole_views_of_house
 
 TOUR_RATE_HZ = 3.0
 #: Share buckets' lower edges.
@@ -58,22 +56,16 @@ class ExtentView:
 
 def views_of_large_objects(house: int, source: HouseSource) -> dict[str, list[ExtentView]]:
     """Per large object ("house/id/class") of held-out house ``house``: its whole views."""
-    description, seed = source.house("test", house)
-    world = World(description, seed=seed, segment=True, darknet_data=source.darknet_data)
     views: dict[str, list[ExtentView]] = defaultdict(list)
-    for frame in Tour(world, TourConfig(rate_hz=TOUR_RATE_HZ)).frames():
-        partial = partial_views(frame.percepts, frame.camera, PartialViewConfig())
-        camera = np.asarray(frame.camera.position, dtype=np.float64)
-        for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
-            if object_id is None or cut or percept.colour is None:
-                continue
-            scale = view_scale(percept)
-            if not (math.isfinite(scale) and scale > 0.0):
-                continue
-            size = np.asarray(percept.size, dtype=np.float64)
-            bearing = math.atan2(camera[1] - percept.position[1], camera[0] - percept.position[0])
-            views[f"{house}/{object_id}/{percept.class_name}"].append(ExtentView(
-                np.asarray(percept.colour, dtype=np.float64), scale, bearing, float(size[2]), float(np.max(size[:2]))))
+    for view in whole_views_of_house(house, source, TOUR_RATE_HZ):
+        percept, camera = view.percept, view.camera
+        scale = view_scale(percept)
+        if not (math.isfinite(scale) and scale > 0.0):
+            continue
+        size = np.asarray(percept.size, dtype=np.float64)
+        bearing = math.atan2(camera[1] - percept.position[1], camera[0] - percept.position[0])
+        views[view.key].append(ExtentView(np.asarray(percept.colour, dtype=np.float64), scale, bearing,
+                                          float(size[2]), float(np.max(size[:2]))))
     return {name: found for name, found in views.items()
             if float(np.percentile([view.footprint for view in found], 90)) > SMALL_OBJECT_EXTENT}
 
