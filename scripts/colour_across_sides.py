@@ -47,7 +47,7 @@ from merlin2_sailor.anchoring.colour_evidence import (
     size_band,
 )
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.whole_views import whole_views_of_house
+from merlin2_sailor_demos.identity.whole_views import collect_houses, whole_views_of_house
 
 TOUR_RATE_HZ = 3.0
 
@@ -95,11 +95,7 @@ def percentiles(values: list[float]) -> str:
 
 def main(houses: int) -> int:
     config = ColourEvidenceConfig()
-    source = HouseSource()
-    objects: dict[str, dict[Side, ColourModel]] = {}
-    for house in range(houses):
-        objects.update(sides_of_objects(house, source))
-        print(f"toured house {house + 1}/{houses}: {len(objects)} objects so far", file=sys.stderr)
+    objects = collect_houses(houses, sides_of_objects)
     known = {name: {side: model for side, model in sides.items() if model.views >= config.minimum_views}
              for name, sides in objects.items()}
     own: dict[str, list[float]] = defaultdict(list)

@@ -34,7 +34,7 @@ from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenc
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
 from merlin2_sailor.anchoring.partial_view import PARTIAL_FOOTPRINT_SHARE
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.whole_views import whole_views_of_house
+from merlin2_sailor_demos.identity.whole_views import collect_houses, whole_views_of_house
 
 #: Frames per second of the tours: enough to see every object from each stop, cheap to render.
 TOUR_RATE_HZ = 3.0
@@ -87,11 +87,7 @@ def a_part(earlier: list[ColourView], view: ColourView) -> bool:
 
 def main(houses: int) -> int:
     config = ColourEvidenceConfig()
-    source = HouseSource()
-    objects: dict[str, list[ColourView]] = {}
-    for house in range(houses):
-        objects.update(whole_views(house, source))
-        print(f"toured house {house + 1}/{houses}: {len(objects)} objects so far", file=sys.stderr)
+    objects = collect_houses(houses, whole_views, "objects")
     returns = 0
     first = {False: 0, True: 0}
     first_two = {False: 0, True: 0}

@@ -36,7 +36,7 @@ from merlin2_sailor.anchoring.anchor import view_scale
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, sized_view_differs, with_sized_view
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.whole_views import whole_views_of_house
+from merlin2_sailor_demos.identity.whole_views import collect_houses, whole_views_of_house
 
 TOUR_RATE_HZ = 3.0
 #: Share buckets' lower edges.
@@ -82,11 +82,7 @@ def bucket(share: float) -> float:
 
 def main(houses: int) -> int:
     config = ColourEvidenceConfig()
-    source = HouseSource()
-    objects: dict[str, list[ExtentView]] = {}
-    for house in range(houses):
-        objects.update(views_of_large_objects(house, source))
-        print(f"toured house {house + 1}/{houses}: {len(objects)} large objects so far", file=sys.stderr)
+    objects = collect_houses(houses, views_of_large_objects, "large objects")
     fullest = {}
     share_of = {}
     for name, views in objects.items():

@@ -9,8 +9,10 @@ real object (not a false detection), and not flagged partial
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import sys
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -43,3 +45,18 @@ def whole_views_of_house(house: int, source: HouseSource, rate_hz: float) -> Ite
         for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
             if object_id is not None and not cut and percept.colour is not None:
                 yield WholeView(percept, frame.stamp, camera, f"{house}/{object_id}/{percept.class_name}")
+
+
+Collected = TypeVar("Collected")
+
+
+def collect_houses(houses: int, collect: Callable[[int, HouseSource], dict[str, Collected]],
+                   what: str = "objects") -> dict[str, Collected]:
+    """``collect`` of each of the first ``houses`` held-out houses, merged (their keys name the house),
+    with a progress line per house on stderr: a tour of a house takes a few seconds."""
+    source = HouseSource()
+    collected: dict[str, Collected] = {}
+    for house in range(houses):
+        collected.update(collect(house, source))
+        print(f"toured house {house + 1}/{houses}: {len(collected)} {what} so far", file=sys.stderr)
+    return collected
