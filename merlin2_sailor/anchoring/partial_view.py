@@ -137,21 +137,22 @@ def colour_comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anc
 
 
 def _shows_another_extent(sizes: np.ndarray, anchors: Sequence[Anchor]) -> np.ndarray:
-    """(P, A) bool: a view and an anchor (its extent known from at least ``EXTENT_CORROBORATING_VIEWS``
-    whole views), one of them of a large object, of which one shows under ``COLOUR_EXTENT_SHARE`` of
-    the other's height or footprint. Either may be the large one: a dog known only end-on (0.27 m of
-    its 0.55) is a small anchor, and its whole view a large one."""
-    known = np.array([a.whole_views >= EXTENT_CORROBORATING_VIEWS for a in anchors], dtype=bool)
+    """(P, A) bool: a view and an anchor of a large object (over ``SMALL_OBJECT_EXTENT`` along any
+    axis, height included: a dog known only end-on is 0.27 m long but 0.52 m tall; its extent known
+    from at least ``EXTENT_CORROBORATING_VIEWS`` whole views) of which one shows under
+    ``COLOUR_EXTENT_SHARE`` of the other's height or footprint. Only the anchor tells what is large:
+    a far view of a mug measured 0.3-0.44 m long by depth noise (tours of the suite's worlds) must
+    still be held to the mug's colour, or a look-alike of another colour would take its anchor."""
+    known = np.array([a.whole_views >= EXTENT_CORROBORATING_VIEWS and float(np.max(a.size)) > SMALL_OBJECT_EXTENT
+                      for a in anchors], dtype=bool)
     result = np.zeros((sizes.shape[0], len(anchors)), dtype=bool)
     if not known.any():
         return result
     anchor_extents = np.array([[float(np.max(a.size[:2])), float(a.size[2])] for a in anchors])
     view_extents = np.column_stack([np.max(sizes[:, :2], axis=1), sizes[:, 2]])
-    large = ((view_extents[:, np.newaxis, 0] > SMALL_OBJECT_EXTENT)
-             | (anchor_extents[np.newaxis, :, 0] > SMALL_OBJECT_EXTENT))
     ratio = view_extents[:, np.newaxis, :] / np.maximum(anchor_extents[np.newaxis, :, :], 1e-9)
     differs = ((ratio < COLOUR_EXTENT_SHARE) | (ratio * COLOUR_EXTENT_SHARE > 1.0)).any(axis=2)
-    return differs & large & known[np.newaxis, :]
+    return differs & known[np.newaxis, :]
 
 
 def _shows_less(sizes: np.ndarray, anchors: Sequence[Anchor]) -> np.ndarray:

@@ -623,8 +623,8 @@ def test_a_part_of_a_large_object_is_no_colour_evidence_against_it(class_name, s
     ("dog", (0.56, 0.25, 0.52), (0.56, 0.25, 0.40), RED, GREEN),
     # The anchor first knew only the top of a cat (its legs hidden), then the whole cat is seen.
     ("cat", (0.47, 0.2, 0.22), (0.47, 0.2, 0.32), BLUE, 3),
-    # A dog first seen end-on, 0.27 m of its 0.55 m (a small anchor, by its own extent), then side on
-    # (`large_object_wheeled_away`, network, seed 2, 7 December 2026).
+    # A dog first seen end-on, 0.27 m of its 0.55 m (small across the floor, not in height), then
+    # side on (`large_object_wheeled_away`, network, seed 2, 7 December 2026).
     ("dog", (0.27, 0.22, 0.52), (0.55, 0.3, 0.52), 9, 14),
     # A horse first seen end-on, 0.6 m of its 1.4 m; then seen whole, side on.
     ("horse", (0.6, 0.5, 1.5), (1.4, 0.5, 1.5), GREEN, RED),
@@ -655,6 +655,19 @@ def test_a_view_showing_more_or_less_of_a_large_objects_height_or_length_is_no_c
     see(anchoring, maker, [first], 0.0)
     result = see(anchoring, maker, [another], 60.0, frames=SUSPICION_FRAMES + 3)
     assert result.percept_symbols == (f"{class_name}_2",)
+
+
+def test_a_small_objects_view_measured_long_by_depth_noise_is_still_held_to_its_colour() -> None:
+    """Only the anchor says what is large: a far view of a mug measured 0.4 m long (depth noise;
+    tours of the suite's worlds measured far mugs 0.3-0.44 m long) where the red mug stood, of
+    another colour, is held to the mug's colour and rules it out, as any view of about its size."""
+    red = SceneObject("red", "cup", KITCHEN, colour=mug_colour(RED))
+    green_measured_long = SceneObject("green", "cup", KITCHEN, size=(0.4, 0.1, 0.11), colour=mug_colour(GREEN))
+    anchoring, maker = rules(), PerceptMaker(seed=17)
+    see(anchoring, maker, [red], 0.0)
+    result = see(anchoring, maker, [green_measured_long], 60.0, frames=SUSPICION_FRAMES + 3)
+    assert result.percept_symbols == ("cup_2",)
+    assert anchoring.get("cup_1").colour_disputed
 
 
 def test_a_first_view_of_another_colour_is_held_until_a_second_one_confirms_it() -> None:
