@@ -265,7 +265,7 @@ class MatchingTableBuilder:
             # seed 0, 5 December 2026).
             # Nor is a view held to an anchor that saw more or less of the object's height or length
             # than it did (:func:`.partial_view.colour_comparable_views`).
-            whole_for = colour_comparable_views(columns.sizes, whole, anchors)
+            whole_for = colour_comparable_views(columns.sizes, whole, anchors, comparable)
             ruled_out, differing, held, colour_gaps = self._ruled_out_by_colour(percepts, anchors, whole_for, ~gated)
             apart = ruled_out | held
             scores[apart] = self.config.gated_score

@@ -115,7 +115,8 @@ def comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anchors: S
 COLOUR_EXTENT_SHARE = 0.8
 
 
-def colour_comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anchors: Sequence[Anchor]) -> np.ndarray:
+def colour_comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anchors: Sequence[Anchor],
+                            comparable: np.ndarray | None = None) -> np.ndarray:
     """(P, A) bool: whether the colour of views of the (P, 3) ``sizes`` may be held to each anchor's.
 
     As :func:`comparable_views`, and more: a large object's view and its anchor's whole views must
@@ -130,9 +131,11 @@ def colour_comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anc
     tours of 60 held-out generated houses (``scripts/view_extents.py``), a large object's whole view
     showing 0.5-0.7 of the object's height or footprint was ruled out by the colour of the object's
     own fullest views 2-3 % of the time, one showing 0.8-0.9 of it 0.9 %. Such a view still counts
-    for the matcher, and is fused, as before.
+    for the matcher, and is fused, as before. ``comparable``: :func:`comparable_views` of the same
+    views, where the caller has it already.
     """
-    comparable = comparable_views(sizes, whole, anchors)
+    if comparable is None:
+        comparable = comparable_views(sizes, whole, anchors)
     return comparable & ~_shows_another_extent(np.asarray(sizes, dtype=np.float64).reshape(-1, 3), anchors)
 
 
