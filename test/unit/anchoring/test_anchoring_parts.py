@@ -148,6 +148,50 @@ def test_two_bicycles_are_never_joined(second: Anchor, why: str):
     assert decide(seen_whole_elsewhere(), first, second) == [], why
 
 
+def _turned(anchor: Anchor) -> Anchor:
+    """The same anchor with the house turned a quarter: x and y swapped."""
+    anchor.position = anchor.position[[1, 0, 2]]
+    anchor.perceived_position = anchor.position.copy()
+    anchor.size = anchor.size[[1, 0, 2]]
+    return anchor
+
+
+def _wheeled_bicycle_seen_from_two_sides(far_end_x: float) -> tuple[Anchor, Anchor, Anchor]:
+    """The anchors of `large_object_wheeled_away`, seed 2 (7 December 2026), read from the run's
+    final snapshot: the bicycle where it stood (53 whole views), a box joined from its near end's
+    parts, and its far end seen from the other side, a narrow box across, shifted sideways."""
+    known = bicycle("bicycle_1", 6.99, np.array((0.36, 1.68, 1.0)), first_seen=0.0,
+                    state=AnchorState.MISSING, whole_views=53, x=5.76)
+    near = bicycle("bicycle_3", 4.81, np.array((0.40, 0.85, 0.84)), first_seen=10.0, whole_views=2, x=3.59)
+    near.parts_fit = np.array((2.10, 0.45, 1.25))
+    far = bicycle("bicycle_7", 5.80, np.array((0.13, 0.46, 1.0)), first_seen=20.0,
+                  state=AnchorState.MISSING, whole_views=2, x=far_end_x)
+    return known, near, far
+
+
+@pytest.mark.parametrize("turn", [False, True], ids=["along y", "along x"])
+@pytest.mark.parametrize("far_end_x", [3.78, 3.40, 3.59], ids=["shifted", "shifted the other way", "in line"])
+def test_parts_seen_from_two_sides_are_joined_though_their_boxes_are_shifted_across(far_end_x, turn):
+    """Their box around both is 0.455 m wide (shifted) where one bicycle is 0.36 m (0.45 with the
+    slack); but the far end's centre lies within the near end's width: one object that wide."""
+    anchors = _wheeled_bicycle_seen_from_two_sides(far_end_x)
+    if turn:
+        anchors = tuple(_turned(anchor) for anchor in anchors)
+    [parts] = decide(*anchors)
+    assert (parts.kept.symbol, parts.part.symbol) == ("bicycle_3", "bicycle_7")
+
+
+@pytest.mark.parametrize("turn", [False, True], ids=["along y", "along x"])
+@pytest.mark.parametrize("far_end_x", [3.80, 3.37], ids=["beside", "beside the other way"])
+def test_boxes_shifted_across_beyond_each_others_width_are_not_one_objects(far_end_x, turn):
+    """The same boxes with the narrow one's centre just past the wide one's side: as two objects
+    side by side stand, so the box around both must fit, and at 0.47 m wide it does not."""
+    anchors = _wheeled_bicycle_seen_from_two_sides(far_end_x)
+    if turn:
+        anchors = tuple(_turned(anchor) for anchor in anchors)
+    assert decide(*anchors) == []
+
+
 def test_parts_seen_at_one_time_are_two_objects():
     front = bicycle("bicycle_2", 3.40, first_seen=10.0)
     rear = bicycle("bicycle_3", 4.55, first_seen=20.0)
