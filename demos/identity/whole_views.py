@@ -1,9 +1,9 @@
 """The whole views of a held-out generated house's objects, as measurement scripts read them.
 
 Scripts that measure how colour behaves across views (``scripts/colour_views_by_size.py``,
-``scripts/colour_across_sides.py``, ``scripts/view_extents.py``) all tour ``sailor evaluate``'s
-held-out houses and keep the views the anchoring layer would take as whole: with a colour, of a
-real object (not a false detection), and not flagged partial
+``scripts/colour_across_sides.py``, ``scripts/view_extents.py``, ``scripts/colour_one_glance.py``)
+all tour ``sailor evaluate``'s held-out houses and keep the views the anchoring layer would take as
+whole: with a colour, of a real object (not a false detection), and not flagged partial
 (:func:`~merlin2_sailor.anchoring.partial_view.partial_views`). One tour, so they measure the same views.
 """
 
