@@ -9,13 +9,15 @@ times their spread; but three frames of one glance at the camera's 15 Hz are nea
 and their spread says little of how the object's colour varies with the light and the angle.
 
 This tours held-out generated houses (as :mod:`colour_views_by_size` does, at the camera's rate),
-and for each return to an object after ``absence`` seconds or more holds its first view, and its
-first two views (the second at least ``second_view_after`` later, as the matching table asks), to
-the object's earlier views of about its size and side, as the anchoring layer does; the returns
-are counted by how many *moments* those earlier views came from (views less than
-``second_view_after`` after the moment's first are one: the matching table's own measure of when a
-second view of another colour comes from another moment).
-Views of other objects of the class, held to the same earlier views, show what the evidence is for.
+groups each object's whole views into *moments* (views less than ``second_view_after`` after the
+moment's first are one: the matching table's own measure of when a second view comes from another
+moment), and makes anchors of ``minimum_views`` views two ways: from one glance (consecutive frames
+of one moment) and from as many moments (the first view of each). Each anchor is held, as the
+anchoring layer holds a single view, to the first view of every later moment of its object
+``absence`` seconds or more after it, and to views of other objects of its class (what the
+evidence is for), wherever all its views are of about the view's size and side.
+Measured on 20 houses (7 December 2026): own views ruled out 4.9 % (one glance) and 4.0 % (three
+moments); other objects' views 79 % and 78 %: one glance is not why own views are ruled out.
 
 Run (needs darknet's photos for the houses' textures, as ``sailor evaluate`` does)::
 
@@ -31,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import view_bearing, view_scale
-from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenceConfig, ColourModel, colour_difference
+from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenceConfig, ColourModel, view_differs
 from merlin2_sailor_demos.identity.house_source import HouseSource
 from merlin2_sailor_demos.identity.whole_views import collect_houses, whole_views_of_house
 
@@ -85,10 +87,6 @@ def held_to(anchor_views: list[ColourView], view: ColourView, config: ColourEvid
     return near if near is not None and near.views == len(anchor_views) else None
 
 
-def differs(model: ColourModel, view: ColourView, config: ColourEvidenceConfig) -> bool:
-    return colour_difference(model, ColourModel.of(view.histogram), config) > 0.0
-
-
 def anchors_of(grouped: list[list[ColourView]], views: int) -> dict[str, list[list[ColourView]]]:
     """Anchors of ``views`` views each: from one glance (consecutive frames of one moment), and
     from as many moments (the first view of each of consecutive moments)."""
@@ -118,12 +116,12 @@ def main(houses: int) -> int:
                     model = held_to(anchor_views, moment[0], config)
                     if model is not None:
                         own[kind][0] += 1
-                        own[kind][1] += differs(model, moment[0], config)
+                        own[kind][1] += view_differs(model, moment[0].histogram, config)
                 for view in rivals:
                     model = held_to(anchor_views, view, config)
                     if model is not None:
                         others[kind][0] += 1
-                        others[kind][1] += differs(model, view, config)
+                        others[kind][1] += view_differs(model, view.histogram, config)
     print(f"tours at {TOUR_RATE_HZ:g} Hz of {houses} held-out houses; a moment: views within {ONE_GLANCE:g} s of "
           f"its first; anchors of {config.minimum_views} whole views; a view held to them only where all "
           f"{config.minimum_views} are of about its size and side")

@@ -139,13 +139,11 @@ def decide_parts(seen: Sequence[Anchor], index: AnchorIndex, slack: float,
         others = sorted((other for other in index.anchors_at(slots) if other.symbol not in settled
                          and _may_be_parts(anchor, other, colour)), key=lambda other: other.first_seen)
         for other in others:
-            low = np.minimum(anchor.position - anchor.size / 2.0, other.position - other.size / 2.0)
-            high = np.maximum(anchor.position + anchor.size / 2.0, other.position + other.size / 2.0)
             fits = bool(np.all(extent_of_both(anchor, other) <= fit))
             if not fits or not (is_part(anchor, known) or is_part(other, known)):
                 continue
             kept, part = (anchor, other) if anchor.first_seen <= other.first_seen else (other, anchor)
-            decisions.append(Parts(kept, part, low, high, known, fit))
+            decisions.append(Parts(kept, part, *box_around(anchor, other), known, fit))
             settled.update((anchor.symbol, other.symbol))
             break
     return decisions
@@ -165,14 +163,20 @@ def extent_of_both(anchor: Anchor, other: Anchor) -> np.ndarray:
     into the other, each centre lies beyond the other's box by half its own width), so this lets no
     two of them in.
     """
-    low = np.minimum(anchor.position - anchor.size / 2.0, other.position - other.size / 2.0)
-    high = np.maximum(anchor.position + anchor.size / 2.0, other.position + other.size / 2.0)
+    low, high = box_around(anchor, other)
     span = high - low
     along, across = (0, 1) if span[0] >= span[1] else (1, 0)
     width = span[across]
     if _centre_within(anchor, other, across) or _centre_within(other, anchor, across):
         width = max(float(anchor.size[across]), float(other.size[across]))
     return np.array([span[along], width, span[2]])
+
+
+def box_around(anchor: Anchor, other: Anchor) -> tuple[np.ndarray, np.ndarray]:
+    """The (low, high) corners (world frame, m) of the box around both anchors' boxes."""
+    low = np.minimum(anchor.position - anchor.size / 2.0, other.position - other.size / 2.0)
+    high = np.maximum(anchor.position + anchor.size / 2.0, other.position + other.size / 2.0)
+    return low, high
 
 
 def _centre_within(anchor: Anchor, other: Anchor, axis: int) -> bool:
