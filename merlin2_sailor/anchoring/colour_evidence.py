@@ -538,14 +538,34 @@ def anchor_colours_differ(first: Coloured, second: Coloured, config: ColourEvide
     the side its lost anchor was known from but four times closer, differed from it by 0.185:
     `large_object_wheeled_away`, network, seed 2, 6 December 2026; the matching function compares
     such an anchor without its look for the same reason, :mod:`.anchor_comparison`)."""
+    return next(_differences_that_count(first, second, config), None) is not None
+
+
+def anchor_colour_gap(first: Coloured, second: Coloured, config: ColourEvidenceConfig) -> float:
+    """By how much two anchors' colours differ where :func:`anchor_colours_differ` says they do
+    (the largest difference that counts), else 0.0: how strong the evidence is, for a rule that
+    weighs it (:meth:`.identity_repair.IdentityRepair.decide_reappearances`)."""
+    return max(_differences_that_count(first, second, config), default=0.0)
+
+
+def _differences_that_count(first: Coloured, second: Coloured, config: ColourEvidenceConfig) -> Iterator[float]:
+    """The differences between two anchors' colours that show they are different objects, one at a
+    time (a caller asking only whether there is one stops at the first): those of their views from
+    each common size and side, or, where none of those differ, their whole models' above
+    ``minimum_difference_across_sides``; nothing unless their whole models differ."""
     if first.parts_fit is not None or second.parts_fit is not None:
-        return False
+        return
     difference = colour_difference(first.colour, second.colour, config)
     if difference == 0.0:
-        return False
+        return
     if first.colour_by_size is None or second.colour_by_size is None:
-        return True
-    if any(colours_differ(own, other, config)
-           for own, other in side_by_side(first.colour_by_size, second.colour_by_size, config)):
-        return True
-    return difference > config.minimum_difference_across_sides
+        yield difference
+        return
+    sides_differ = False
+    for own, other in side_by_side(first.colour_by_size, second.colour_by_size, config):
+        side = colour_difference(own, other, config)
+        if side > 0.0:
+            sides_differ = True
+            yield side
+    if not sides_differ and difference > config.minimum_difference_across_sides:
+        yield difference

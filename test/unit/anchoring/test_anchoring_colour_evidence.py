@@ -24,6 +24,7 @@ from merlin2_sailor.anchoring.colour_evidence import (
     ColourBySize,
     ColourEvidenceConfig,
     ColourModel,
+    anchor_colour_gap,
     anchor_colours_differ,
     colour_difference,
     colour_windows,
@@ -863,6 +864,24 @@ def test_anchors_never_seen_from_a_common_side_differ_only_by_more_than_one_obje
     assert anchor_colours_differ(first, second, ColourEvidenceConfig(minimum_difference_across_sides=0.1))
     with pytest.raises(ConfigurationError, match="across_sides"):
         ColourEvidenceConfig(minimum_difference_across_sides=0.05)
+
+
+@pytest.mark.parametrize("share", [0.12, 0.14, 0.2, 0.3])
+@pytest.mark.parametrize("sides", [(SIDE_A, SIDE_A), (SIDE_A, SIDE_B)])
+def test_the_gap_between_two_anchors_colours_is_the_largest_difference_that_counts(share, sides) -> None:
+    """:func:`anchor_colour_gap` weighs what :func:`anchor_colours_differ` decides: 0 exactly where
+    they do not differ, else the largest difference that counts (from a common side the views',
+    from none the whole models', beyond what one object's sides differ by)."""
+    rng = np.random.default_rng(int(share * 100))
+    first = sided_anchor([(view, sides[0]) for view in noisy_views(mug_colour(RED, 0.3), 12, rng, 0.005)])
+    second = sided_anchor([(view, sides[1]) for view in noisy_views(mug_colour(RED, 0.3 + share), 6, rng, 0.005)])
+    config = ColourEvidenceConfig()
+    gap = anchor_colour_gap(first, second, config)
+    assert (gap > 0.0) is anchor_colours_differ(first, second, config)
+    assert gap == anchor_colour_gap(second, first, config)
+    shown = share > config.minimum_difference_across_sides or sides[0] == sides[1]
+    assert gap == (pytest.approx(share, abs=0.02) if shown else 0.0)
+    assert anchor_colour_gap(first, dataclasses.replace(second, parts_fit=np.ones(3)), config) == 0.0
 
 
 def looking_at(target, bearing: float, distance: float = 3.0):
