@@ -41,7 +41,10 @@ cut off) cannot bring it back either, only a view of its own colour can (in the 
 of the green mug had reacquired the red mug's anchor before a close one showed green). A view
 wrongly ruled out makes a new anchor for a while, which the reappearance merge folds back once the
 two anchors' colours agree. Measured on tours of the house over three seeds, this costs one or two
-duplicate anchors in all (rules: 5 duplicates, was 3; the network: 4, was 3).
+duplicate anchors in all (rules: 5 duplicates, was 3; the network: 4, was 3). Where the two anchors'
+colours differ by no more than one object's own views do (:func:`anchor_colour_gap`, at most
+``minimum_difference_across_sides``), the reappearance is left undecided instead: the lost anchor
+names the newcomer it cannot be told from (:meth:`.identity_repair.IdentityRepair.decide_reappearances`).
 
 A single view is compared only with the anchor's views *of about its size* (``comparable_size``:
 at most twice as large or small, by the square root of the box's area), kept as one model per

@@ -35,7 +35,9 @@ score at or above the match threshold, a candidate must be possible at all:
   (:mod:`.colour_evidence`; the rules have no other appearance, and the learned matcher's is
   fooled by a look-alike where the lost one stood). A mug of another colour found where the red
   mug is sought is never taken for it, with either matcher: the red mug stays missing, and a
-  search reports it not found.
+  search reports it not found. A reappearance held apart by colour alone, by no more than one
+  object's own views differ, is not decided either way: the lost anchor names the newcomer it
+  cannot be told from (:meth:`IdentityRepair._in_doubt`).
 
 A candidate is taken only when it is clearly the best (by ``ambiguity_margin``) for the lost
 anchor, *and* the lost anchor is clearly the best of every other MISSING anchor the candidate
@@ -409,9 +411,9 @@ class IdentityRepair:
         Why: colour that differs by that little is weak evidence, and deciding on it either way is a
         guess presented as fact. Measured on tours of 20 held-out generated houses
         (``scripts/colour_doubt.py``): anchors known from one glance (3 frames) were held apart
-        from an anchor of their own object's later visit 90 times, 54 % of them by 0.16 or less,
-        while anchors of other objects of the class held apart differed by 0.16 or less in 6.9 %
-        (589 of 8,479). Decided, such a difference made two anchors of one bird a metre from the
+        from an anchor of a later visit of their own object in 90 of 2,208 pairs, 54 % of them by
+        0.16 or less, from one of another object of the class in 8,479 of 10,633, 6.9 % of them
+        (589) by 0.16 or less. Decided, such a difference made two anchors of one bird a metre from the
         wheeled bicycle: known from three frames of one glance, its views 86 s later differed by 0.11
         in one hue window, and a new anchor stood 0.02 m from the old, missing one
         (`large_object_wheeled_away`, network, seeds 0 and 1, 7 December 2026). Stated as a doubt, the

@@ -424,7 +424,9 @@ SETTINGS: tuple[Setting, ...] = (
         Setting("colour_minimum_difference_across_sides", ("core", "colour", "minimum_difference_across_sides"),
                 "Share of an object's pixels by which two anchors' colours must differ to rule out one object "
                 "where none of their views from a common size and side differ (one object's sides differ by "
-                "up to about 0.16; at least colour_minimum_difference).", 0.001, 0.999),
+                "up to about 0.16; at least colour_minimum_difference). Also the most by which a newcomer in a "
+                "missing anchor's place may differ from it for the reappearance to be left undecided rather "
+                "than decided by colour.", 0.001, 0.999),
         Setting("colour_place_radius", ("core", "colour", "place_radius"),
                 "How near (m, horizontally) to an anchor one whole view must stand for its colour to count "
                 "against it, nearer to no other anchor of its class (a view elsewhere is another object, or "
