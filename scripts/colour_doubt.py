@@ -41,7 +41,12 @@ from merlin2_sailor.anchoring.colour_evidence import (
     anchor_colours_differ,
 )
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.whole_views import WholeView, collect_houses, whole_views_of_house
+from merlin2_sailor_demos.identity.whole_views import (
+    WholeView,
+    collect_houses,
+    grouped_in_time,
+    whole_views_of_house,
+)
 
 #: Frames per second of the tours: the demo camera's rate, at which one glance gives several frames.
 TOUR_RATE_HZ = 15.0
@@ -78,18 +83,6 @@ def anchor_of(views: list[WholeView]) -> ColouredAnchor:
     return ColouredAnchor(colour, by_size)
 
 
-def grouped(views: list[WholeView], within: float, since_first: bool) -> list[list[WholeView]]:
-    """The views in groups: a view ``within`` seconds of the group's first (``since_first``) or last
-    view joins it, a later one begins the next."""
-    groups: list[list[WholeView]] = []
-    for view in views:
-        if groups and view.stamp - groups[-1][0 if since_first else -1].stamp < within:
-            groups[-1].append(view)
-        else:
-            groups.append([view])
-    return groups
-
-
 def views_of_house(house: int, source: HouseSource) -> dict[str, list[WholeView]]:
     views: dict[str, list[WholeView]] = defaultdict(list)
     for view in whole_views_of_house(house, source, TOUR_RATE_HZ):
@@ -117,14 +110,14 @@ def pairs_held_apart(objects: dict[str, list[WholeView]], config: ColourEvidence
         house, _, class_name = name.split("/")
         rivals = [other for key, other in objects.items()
                   if key != name and key.split("/")[0] == house and key.split("/")[2] == class_name]
-        glances = [moment[:GLANCE_VIEWS] for moment in grouped(views, ONE_GLANCE, since_first=True)
+        glances = [moment[:GLANCE_VIEWS] for moment in grouped_in_time(views, ONE_GLANCE, since_first=True)
                    if len(moment) >= GLANCE_VIEWS][:GLANCES_PER_OBJECT]
         for glance in glances:
             known = anchor_of(glance)
             later = [view for view in views if view.stamp - glance[-1].stamp >= config.absence]
-            visits = [(own, visit) for visit in grouped(later, ONE_VISIT, since_first=False)]
+            visits = [(own, visit) for visit in grouped_in_time(later, ONE_VISIT, since_first=False)]
             visits += [(others, visit) for rival in rivals
-                       for visit in grouped(rival, ONE_VISIT, since_first=False)[:VISITS_PER_RIVAL]]
+                       for visit in grouped_in_time(rival, ONE_VISIT, since_first=False)[:VISITS_PER_RIVAL]]
             for pairs, visit in visits:
                 if len(visit) < GLANCE_VIEWS:
                     continue

@@ -35,7 +35,7 @@ import numpy as np
 from merlin2_sailor.anchoring.anchor import view_bearing, view_scale
 from merlin2_sailor.anchoring.colour_evidence import ColourBySize, ColourEvidenceConfig, ColourModel, view_differs
 from merlin2_sailor_demos.identity.house_source import HouseSource
-from merlin2_sailor_demos.identity.whole_views import collect_houses, whole_views_of_house
+from merlin2_sailor_demos.identity.whole_views import collect_houses, grouped_in_time, whole_views_of_house
 
 #: Frames per second of the tours: the demo camera's rate, at which one glance gives several frames.
 TOUR_RATE_HZ = 15.0
@@ -68,13 +68,7 @@ def whole_views(house: int, source: HouseSource) -> dict[str, list[ColourView]]:
 def moments_of(views: list[ColourView]) -> list[list[ColourView]]:
     """The views grouped into moments: a view ``ONE_GLANCE`` or more after the moment's first
     begins the next."""
-    grouped: list[list[ColourView]] = []
-    for view in views:
-        if grouped and view.stamp - grouped[-1][0].stamp < ONE_GLANCE:
-            grouped[-1].append(view)
-        else:
-            grouped.append([view])
-    return grouped
+    return grouped_in_time(views, ONE_GLANCE, since_first=True)
 
 
 def held_to(anchor_views: list[ColourView], view: ColourView, config: ColourEvidenceConfig) -> ColourModel | None:

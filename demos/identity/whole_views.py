@@ -12,7 +12,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Protocol, TypeVar
 
 import numpy as np
 
@@ -45,6 +45,26 @@ def whole_views_of_house(house: int, source: HouseSource, rate_hz: float) -> Ite
         for percept, object_id, cut in zip(frame.percepts, frame.object_ids, partial, strict=True):
             if object_id is not None and not cut and percept.colour is not None:
                 yield WholeView(percept, frame.stamp, camera, f"{house}/{object_id}/{percept.class_name}")
+
+
+class Stamped(Protocol):
+    stamp: float
+
+
+StampedView = TypeVar("StampedView", bound=Stamped)
+
+
+def grouped_in_time(views: list[StampedView], within: float, since_first: bool) -> list[list[StampedView]]:
+    """Time-ordered views in groups: a view less than ``within`` seconds after the group's first
+    (``since_first``: one moment, one glance) or its last view (else: one visit) joins it, a later
+    one begins the next."""
+    groups: list[list[StampedView]] = []
+    for view in views:
+        if groups and view.stamp - groups[-1][0 if since_first else -1].stamp < within:
+            groups[-1].append(view)
+        else:
+            groups.append([view])
+    return groups
 
 
 Collected = TypeVar("Collected")

@@ -420,13 +420,14 @@ class IdentityRepair:
         lost anchor stays missing and names the newcomer it cannot be told from, as twins do; a
         search for it ends saying so; a larger difference (another colour put in its place) still
         decides, and a later agreement of the colours still merges them."""
-        doubt_level = self.colour.minimum_difference_across_sides
-        doubted = [
+        near = [
             anchor for anchor in self._near(missing, index)
             if anchor.symbol not in taken and anchor.state is AnchorState.CONFIRMED
             and self._possible_by_time_and_place(anchor, missing, include_missing=False)
-            and 0.0 < anchor_colour_gap(anchor, missing, self.colour) <= doubt_level
         ]
+        gaps = {anchor.symbol: anchor_colour_gap(anchor, missing, self.colour) for anchor in near}
+        doubt_level = self.colour.minimum_difference_across_sides
+        doubted = [anchor for anchor in near if 0.0 < gaps[anchor.symbol] <= doubt_level]
         if not doubted:
             return None
         scores = self._scores(doubted, missing, self._where_it_went_missing(missing))
@@ -434,10 +435,10 @@ class IdentityRepair:
         if not alike:
             return None
         found = tuple(doubted[k] for k in alike)
-        gaps = ", ".join(f"{anchor_colour_gap(anchor, missing, self.colour):.2f}" for anchor in found)
         return Undecided((missing,), found, tuple(float(scores[k]) for k in alike),
                          f"{missing.symbol} may be {', '.join(a.symbol for a in found)}, where it went missing: "
-                         f"the colours differ by {gaps}, no more than one object's own views do")
+                         f"the colours differ by {', '.join(f'{gaps[a.symbol]:.2f}' for a in found)}, no more than "
+                         "one object's own views do")
 
     # --- relocations ------------------------------------------------------------------------
 
