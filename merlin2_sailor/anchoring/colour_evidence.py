@@ -544,6 +544,34 @@ def anchor_colours_differ(first: Coloured, second: Coloured, config: ColourEvide
     return next(_differences_that_count(first, second, config), None) is not None
 
 
+def part_shows_a_colour_the_whole_lacks(part: Coloured, whole: Coloured, config: ColourEvidenceConfig) -> bool:
+    """Whether ``part``, an anchor of a part of a large object (:mod:`.parts`), cannot be of the
+    object ``whole`` is an anchor of by its colour: it shows more of some colour window than the
+    whole one does, beyond ``minimum_difference`` and the noise, where the whole one shows less
+    than ``minimum_difference`` of that colour. Nothing else of its colour is evidence: a part
+    shows only some of its object's faces, so its colours come in other shares than the whole's (a
+    bicycle's part, its tyre's black twice the whole bicycle's share and its frame's orange half,
+    differed from the bicycle by 0.20, and :func:`anchor_colours_differ` held them apart:
+    `moved_to_the_far_room`, network, seed 0, 7 December 2026), but it shows nothing the object
+    lacks (a red bicycle's part is not of a blue bicycle). As in :func:`colour_difference`, one of
+    the two must know its colour (``minimum_views``), and a side with fewer views is held to the
+    known side's spread."""
+    if config.minimum_views == 0 or part.colour is None or whole.colour is None:
+        return False
+    if part.parts_fit is not None or whole.parts_fit is not None:
+        return False
+    part_model, whole_model = lit_alike(part.colour), lit_alike(whole.colour)
+    part_known, whole_known = part_model.views >= config.minimum_views, whole_model.views >= config.minimum_views
+    if not (part_known or whole_known):
+        return False
+    part_variance = part_model.variance if part_known else whole_model.variance
+    whole_variance = whole_model.variance if whole_known else part_model.variance
+    excess = part_model.mean - whole_model.mean
+    noise = config.noise_factor * np.sqrt(part_variance + whole_variance)
+    foreign = (excess > config.minimum_difference) & (excess > noise) & (whole_model.mean < config.minimum_difference)
+    return bool(foreign.any())
+
+
 def anchor_colour_gap(first: Coloured, second: Coloured, config: ColourEvidenceConfig) -> float:
     """By how much two anchors' colours differ where :func:`anchor_colours_differ` says they do
     (the largest difference that counts), else 0.0: how strong the evidence is, for a rule that

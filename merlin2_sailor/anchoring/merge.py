@@ -11,8 +11,6 @@ become one anchor, the older, whose box is the box around both.
 
 from __future__ import annotations
 
-import numpy as np
-
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.events import AnchorEventKind
@@ -21,7 +19,7 @@ from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.identity_repair import Decision, Merge, Unconfirmed
 from merlin2_sailor.anchoring.observation import drop_expectation
 from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS
-from merlin2_sailor.anchoring.parts import Parts, is_part
+from merlin2_sailor.anchoring.parts import Parts, is_part, reaches_past
 from merlin2_sailor.anchoring.percept_checks import position_text
 from merlin2_sailor.anchoring.place_return import Return, trade_places
 from merlin2_sailor.anchoring.same_space import Duplicate
@@ -40,24 +38,20 @@ def withdraw_stale_ambiguities(index: AnchorIndex) -> None:
             anchor.found_by_look_alone = ""
 
 
-def _reaches_past(whole: Anchor, part: Anchor) -> bool:
-    """Whether the part's centre lies outside the whole one's box, across the floor."""
-    return bool(np.any(np.abs(part.position[:2] - whole.position[:2]) > whole.size[:2] / 2.0))
-
-
 def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig) -> None:
     """Make two parts of one object one anchor: the older symbol, the views of both, and the box of
-    the whole one where one of them is whole and the other's centre lies within it, else the box
-    around both.
+    the whole one where one of them is whole and the other does not reach past it
+    (:func:`.parts.reaches_past`), else the box around both.
 
-    A part whose centre lies beyond the whole one's box shows that the object reaches farther than
+    A part whose centre lies beyond the whole one's box along the object shows that the object reaches farther than
     those views did: they were whole by the partial-view tests, not by the object (a footprint over
     ``PARTIAL_FOOTPRINT_SHARE`` of the whole one's is not a part, yet may miss a quarter of it). The
     wheeled bicycle's near end, seen from the hall without a cut, made an anchor 1.23 m long centred
     0.5 m from the bicycle's middle, and six views of its far end were joined into it without moving
     it, so the found bicycle stood half a metre off (scenario suite, `large_object_wheeled_away`,
     network, seed 1, 6 December 2026). A part within the box is noise of it (a part's box reaches
-    past the object by a few decimetres), and the whole box stays.
+    past the object by a few decimetres), and so is one sticking out across it while sharing its
+    width (the depth band took in what stood before the object): the whole box stays.
 
     One of the two was seen in this frame, so the object is: the anchor is confirmed and visible.
     A part's appearance views are dropped (:mod:`.parts` says why). A box around parts holds later
@@ -73,7 +67,7 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     for anchor in (kept, part):
         if anchor is not whole:  # its views are of parts, not of the object (see parts)
             anchor.gallery = anchor.gallery_scales = None
-    if whole is not None and _reaches_past(whole, part if whole is kept else kept):
+    if whole is not None and reaches_past(whole, part if whole is kept else kept):
         box = ((decision.low + decision.high) / 2.0, decision.high - decision.low,
                max(whole.whole_views, EXTENT_CORROBORATING_VIEWS), decision.fit)
     elif whole is not None:

@@ -10,14 +10,17 @@ parts taken as the extent of its class.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState
+from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, colour_evidence
 from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel, with_view
 from merlin2_sailor.anchoring.expectation import Expectation
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.gallery import add_view
@@ -25,8 +28,9 @@ from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.merge import join_parts
 from merlin2_sailor.anchoring.parts import Parts, decide_parts, largest_seen_whole
-from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict
+from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict, anchors_of_snapshot
 from merlin2_sailor.errors import ConfigurationError
+from merlin2_sailor.perception.colour_histogram import COLOUR_BINS, HUE_BINS
 
 from .anchoring_scenes import AppearanceRules, PerceptMaker, SceneObject, mug_colour
 
@@ -170,10 +174,13 @@ def _wheeled_bicycle_seen_from_two_sides(far_end_x: float) -> tuple[Anchor, Anch
 
 
 @pytest.mark.parametrize("turn", [False, True], ids=["along y", "along x"])
-@pytest.mark.parametrize("far_end_x", [3.78, 3.40, 3.59], ids=["shifted", "shifted the other way", "in line"])
+@pytest.mark.parametrize("far_end_x", [3.78, 3.40, 3.59, 3.80, 3.37],
+                         ids=["shifted", "shifted the other way", "in line", "centre just past its side",
+                              "centre just past its other side"])
 def test_parts_seen_from_two_sides_are_joined_though_their_boxes_are_shifted_across(far_end_x, turn):
-    """Their box around both is 0.455 m wide (shifted) where one bicycle is 0.36 m (0.45 with the
-    slack); but the far end's centre lies within the near end's width: one object that wide."""
+    """Their box around both is 0.455-0.475 m wide where one bicycle is 0.36 m (0.45 with the
+    slack); but the far end's box shares some of the near end's width, its centre within it or
+    just past its side: one object that wide."""
     anchors = _wheeled_bicycle_seen_from_two_sides(far_end_x)
     if turn:
         anchors = tuple(_turned(anchor) for anchor in anchors)
@@ -182,14 +189,46 @@ def test_parts_seen_from_two_sides_are_joined_though_their_boxes_are_shifted_acr
 
 
 @pytest.mark.parametrize("turn", [False, True], ids=["along y", "along x"])
-@pytest.mark.parametrize("far_end_x", [3.80, 3.37], ids=["beside", "beside the other way"])
-def test_boxes_shifted_across_beyond_each_others_width_are_not_one_objects(far_end_x, turn):
-    """The same boxes with the narrow one's centre just past the wide one's side: as two objects
-    side by side stand, so the box around both must fit, and at 0.47 m wide it does not."""
+@pytest.mark.parametrize("far_end_x", [3.87, 3.31, 4.20], ids=["beside", "beside the other way", "farther"])
+def test_boxes_clear_of_each_other_across_are_not_one_object(far_end_x, turn):
+    """The same boxes with the narrow one clear of the wide one's side (by 0.015 m and more), as two
+    objects side by side stand: the box around both must fit, and at 0.545 m wide and more it does
+    not."""
     anchors = _wheeled_bicycle_seen_from_two_sides(far_end_x)
     if turn:
         anchors = tuple(_turned(anchor) for anchor in anchors)
     assert decide(*anchors) == []
+
+
+PART_BESIDE_ITS_WHOLE = Path(__file__).parent / "data" / "bicycle_part_beside_its_whole.json"
+
+
+@pytest.mark.parametrize("turn", [False, True], ids=["along y", "along x"])
+def test_the_suites_part_reaching_past_its_bicycles_side_is_joined_and_the_bicycle_keeps_its_width(turn):
+    """The run's own anchors (`moved_to_the_far_room`, network, seed 0, 7 December 2026, the final
+    snapshot): a part of the hall's bicycle seen first (0.15 x 0.84 m, its box reaching 0.125 m past
+    the bicycle's side, its centre 0.05 m beyond the whole box's width) and the bicycle seen whole
+    88 times (0.36 x 1.65 m). The box around both is 0.485 m wide against the 0.45 m one bicycle
+    may fill, so the run kept two anchors of it; their boxes share 0.03 m of width, so they are one
+    bicycle, kept under the older symbol on the whole one's box, not widened by the part's error."""
+    snapshot = json.loads(PART_BESIDE_ITS_WHOLE.read_text())
+    anchors, _ = anchors_of_snapshot(snapshot, snapshot["world_frame"])
+    if turn:
+        anchors = [_turned(anchor) for anchor in anchors]
+    part, whole = sorted(anchors, key=lambda anchor: anchor.symbol)
+    assert (part.symbol, whole.symbol, part.whole_views, whole.whole_views) == ("bicycle_1", "bicycle_3", 1, 88)
+    whole_box = (whole.position.copy(), whole.size.copy())
+    for anchor in anchors:
+        anchor.visible = True
+    [parts] = decide(part, whole)
+    assert (parts.kept, parts.part) == (part, whole)
+    index = AnchorIndex()
+    for anchor in anchors:
+        index.add(anchor)
+    join_parts(parts, index, FrameChanges(whole.last_seen), AnchoringConfig().fusion)
+    assert "bicycle_3" not in index and part.state is AnchorState.CONFIRMED
+    np.testing.assert_allclose(part.position, whole_box[0])
+    np.testing.assert_allclose(part.size, whole_box[1])
 
 
 def test_parts_seen_at_one_time_are_two_objects():
@@ -222,6 +261,54 @@ def test_a_box_built_from_parts_is_not_the_extent_of_its_class_but_the_whole_one
     assert decide(joined, front, bicycle("bicycle_4", 5.20, first_seen=20.0)) == []  # 2.25 m: too long
     [parts] = decide(joined, front, bicycle("bicycle_4", 4.55, first_seen=20.0))
     assert parts.kept is front
+
+
+def bicycle_colour(frame_hue: int, frame: float, tyres: float, rng: np.random.Generator) -> np.ndarray:
+    """A bicycle's colour as a view shows it: ``frame`` of the pixels in its frame's hue bin,
+    ``tyres`` in dark grey, the rest light grey, each share a little off from view to view."""
+    histogram = np.zeros(COLOUR_BINS)
+    histogram[frame_hue], histogram[HUE_BINS] = frame, tyres
+    histogram[HUE_BINS + 2] = 1.0 - frame - tyres
+    histogram = np.clip(histogram + rng.normal(0.0, 0.01, COLOUR_BINS) * (histogram > 0), 0.0, None)
+    return histogram / histogram.sum()
+
+
+def coloured(anchor: Anchor, frame_hue: int, frame: float, tyres: float, views: int) -> Anchor:
+    rng = np.random.default_rng(views + frame_hue)
+    for _ in range(views):
+        anchor.colour = with_view(anchor.colour, bicycle_colour(frame_hue, frame, tyres, rng))
+    return anchor
+
+
+@pytest.mark.parametrize(("part_hue", "frame", "tyres", "joined"), [
+    (1, 0.25, 0.45, True),   # a wheel: twice the whole's black, half its orange
+    (1, 0.15, 0.20, True),   # a part showing more of the light grey mudguards
+    (1, 0.65, 0.10, True),   # the frame up close: more orange, less black
+    (8, 0.30, 0.40, False),  # a blue bicycle's part: a colour the orange one lacks
+    (13, 0.20, 0.20, False),  # a purple one's
+])
+def test_a_part_beside_a_whole_one_is_held_only_to_showing_no_colour_the_whole_lacks(part_hue, frame, tyres,
+                                                                                     joined):
+    """A part shows some of its object's faces, so its colours come in other shares than the whole
+    one's, by more than two anchors of one object may differ; what it cannot show is a colour the
+    object lacks."""
+    whole = coloured(bicycle("bicycle_2", 4.0, BICYCLE, first_seen=10.0, whole_views=6), 1, 0.45, 0.20, views=6)
+    part = coloured(bicycle("bicycle_3", 4.5, first_seen=20.0), part_hue, frame, tyres, views=2)
+    if joined:
+        assert colour_evidence.anchor_colours_differ(part, whole, COLOUR)  # as any two anchors, they differ
+        [parts] = decide(whole, part)
+        assert (parts.kept, parts.part) == (whole, part)
+    else:
+        assert decide(whole, part) == []
+
+
+def test_a_parts_colour_is_evidence_only_where_one_of_the_two_knows_its_colour():
+    whole = coloured(bicycle("bicycle_2", 4.0, BICYCLE, first_seen=10.0, whole_views=6), 1, 0.45, 0.20, views=2)
+    part = coloured(bicycle("bicycle_3", 4.5, first_seen=20.0), 8, 0.30, 0.40, views=2)
+    assert not colour_evidence.part_shows_a_colour_the_whole_lacks(part, whole, COLOUR)
+    assert colour_evidence.part_shows_a_colour_the_whole_lacks(coloured(part, 8, 0.30, 0.40, views=1), whole, COLOUR)
+    assert colour_evidence.part_shows_a_colour_the_whole_lacks(part, coloured(whole, 1, 0.45, 0.20, views=1), COLOUR)
+    assert not colour_evidence.part_shows_a_colour_the_whole_lacks(whole, part, ColourEvidenceConfig(minimum_views=0))
 
 
 def test_other_colours_an_expected_anchor_and_tentative_ones_are_left_alone():
