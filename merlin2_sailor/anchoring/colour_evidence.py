@@ -279,22 +279,34 @@ def combined(first: ColourModel | None, second: ColourModel | None) -> ColourMod
     return first.merged(second)
 
 
+def _compared_with_noise(first: ColourModel | None, second: ColourModel | None, config: ColourEvidenceConfig
+                         ) -> tuple[ColourModel, ColourModel, np.ndarray] | None:
+    """Both models as every comparison takes them (:func:`lit_alike`), with the noise a window's
+    difference must exceed (``noise_factor`` standard deviations of both sides' views; a side with
+    fewer than ``minimum_views`` views held to the known side's spread); None where nothing can be
+    told: evidence off, a side without colour, or neither side knowing its colour."""
+    if config.minimum_views == 0 or first is None or second is None:
+        return None
+    first, second = lit_alike(first), lit_alike(second)
+    first_known, second_known = first.views >= config.minimum_views, second.views >= config.minimum_views
+    if not (first_known or second_known):
+        return None
+    first_variance = first.variance if first_known else second.variance
+    second_variance = second.variance if second_known else first.variance
+    return first, second, config.noise_factor * np.sqrt(first_variance + second_variance)
+
+
 def colour_difference(first: ColourModel | None, second: ColourModel | None, config: ColourEvidenceConfig) -> float:
     """The largest window difference that counts as evidence (see the module docstring), or 0.0
     when there is none: no colour on either side, neither side with ``minimum_views`` (nobody
     knows the colour yet), or every difference within the noise. A side with fewer views (a
     newcomer, one view) is held to the known side's spread: its own few views cannot say how much
     the object's colour varies."""
-    if config.minimum_views == 0 or first is None or second is None:
+    compared = _compared_with_noise(first, second, config)
+    if compared is None:
         return 0.0
-    first, second = lit_alike(first), lit_alike(second)
-    first_known, second_known = first.views >= config.minimum_views, second.views >= config.minimum_views
-    if not (first_known or second_known):
-        return 0.0
-    first_variance = first.variance if first_known else second.variance
-    second_variance = second.variance if second_known else first.variance
+    first, second, noise = compared
     difference = np.abs(first.mean - second.mean)
-    noise = config.noise_factor * np.sqrt(first_variance + second_variance)
     counted = (difference > config.minimum_difference) & (difference > noise)
     return float(difference[counted].max()) if counted.any() else 0.0
 
@@ -556,18 +568,13 @@ def part_shows_a_colour_the_whole_lacks(part: Coloured, whole: Coloured, config:
     lacks (a red bicycle's part is not of a blue bicycle). As in :func:`colour_difference`, one of
     the two must know its colour (``minimum_views``), and a side with fewer views is held to the
     known side's spread."""
-    if config.minimum_views == 0 or part.colour is None or whole.colour is None:
-        return False
     if part.parts_fit is not None or whole.parts_fit is not None:
         return False
-    part_model, whole_model = lit_alike(part.colour), lit_alike(whole.colour)
-    part_known, whole_known = part_model.views >= config.minimum_views, whole_model.views >= config.minimum_views
-    if not (part_known or whole_known):
+    compared = _compared_with_noise(part.colour, whole.colour, config)
+    if compared is None:
         return False
-    part_variance = part_model.variance if part_known else whole_model.variance
-    whole_variance = whole_model.variance if whole_known else part_model.variance
+    part_model, whole_model, noise = compared
     excess = part_model.mean - whole_model.mean
-    noise = config.noise_factor * np.sqrt(part_variance + whole_variance)
     foreign = (excess > config.minimum_difference) & (excess > noise) & (whole_model.mean < config.minimum_difference)
     return bool(foreign.any())
 

@@ -43,8 +43,8 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     the whole one where one of them is whole and the other does not reach past it
     (:func:`.parts.reaches_past`), else the box around both.
 
-    A part whose centre lies beyond the whole one's box along the object shows that the object reaches farther than
-    those views did: they were whole by the partial-view tests, not by the object (a footprint over
+    A part whose centre lies beyond the whole one's box along the object shows that the object
+    reaches farther than those views did: they were whole by the partial-view tests, not by the object (a footprint over
     ``PARTIAL_FOOTPRINT_SHARE`` of the whole one's is not a part, yet may miss a quarter of it). The
     wheeled bicycle's near end, seen from the hall without a cut, made an anchor 1.23 m long centred
     0.5 m from the bicycle's middle, and six views of its far end were joined into it without moving
