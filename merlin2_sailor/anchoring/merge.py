@@ -44,14 +44,15 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     (:func:`.parts.reaches_past`), else the box around both.
 
     A part whose centre lies beyond the whole one's box along the object shows that the object
-    reaches farther than those views did: they were whole by the partial-view tests, not by the object (a footprint over
-    ``PARTIAL_FOOTPRINT_SHARE`` of the whole one's is not a part, yet may miss a quarter of it). The
-    wheeled bicycle's near end, seen from the hall without a cut, made an anchor 1.23 m long centred
-    0.5 m from the bicycle's middle, and six views of its far end were joined into it without moving
-    it, so the found bicycle stood half a metre off (scenario suite, `large_object_wheeled_away`,
-    network, seed 1, 6 December 2026). A part within the box is noise of it (a part's box reaches
-    past the object by a few decimetres), and so is one sticking out across it while sharing its
-    width (the depth band took in what stood before the object): the whole box stays.
+    reaches farther than those views did: they were whole by the partial-view tests, not by the
+    object (a footprint over ``PARTIAL_FOOTPRINT_SHARE`` of the whole one's is not a part, yet may
+    miss a quarter of it). The wheeled bicycle's near end, seen from the hall without a cut, made an
+    anchor 1.23 m long centred 0.5 m from the bicycle's middle, and six views of its far end were
+    joined into it without moving it, so the found bicycle stood half a metre off (scenario suite,
+    `large_object_wheeled_away`, network, seed 1, 6 December 2026). A part within the box is noise
+    of it (a part's box reaches past the object by a few decimetres), and so is one sticking out
+    across it while sharing its width (the depth band took in what stood before the object): the
+    whole box stays.
 
     One of the two was seen in this frame, so the object is: the anchor is confirmed and visible.
     A part's appearance views are dropped (:mod:`.parts` says why). A box around parts holds later
