@@ -182,6 +182,10 @@ class Anchor:
     (:meth:`~.anchoring.Anchoring.conclude_search`); cleared once taken, once a copy makes the case
     undecided, or once the candidate is gone (a sighting of this anchor on the way does not clear
     it: it may go missing again); empty: none."""
+    look_pending: tuple[str, ...] = ()
+    """While MISSING: anchors a search for this one met that it could not yet tell apart, for want
+    of a look at some of them (:class:`~.identity_repair.LookPending`); the search looks on, and if
+    it concludes with them still possible, they are what this one cannot be told from. Empty: none."""
     parts_fit: np.ndarray | None = None
     """Where its box is the box around parts of it, joined (:mod:`.parts`), not a whole view's: the
     extent (:func:`turned_extent`) of the whole one of its class its parts were fit in, slack

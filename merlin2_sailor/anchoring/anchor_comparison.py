@@ -67,18 +67,8 @@ def identity_scores(
     candidate: a (len(candidates),) array in [0, 1]."""
     if not candidates:
         return np.zeros(0)
-    # A candidate that knows only a part of a large lost object (a view end-on, through a door)
-    # is compared without its look, as a partial percept is (matching_table.comparable_views);
-    # so is a lost anchor that knew only a part of what the candidate shows whole (a bicycle's
-    # end anchored first, the whole bicycle later: scenario suite, 4 December, a duplicate).
-    # So is a candidate whose box was joined from parts (:mod:`.parts`): its views are its parts',
-    # the whole object's look it never saw (the joined bicycle of `large_object_wheeled_away` was
-    # never taken by the search for the bicycle it was: scenario suite, network, 6 December 2026).
-    sizes = np.array([anchor.size for anchor in candidates])
-    comparable = (comparable_views(sizes, None, [lost])[:, 0]
-                  & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0]
-                  & np.array([anchor.parts_fit is None for anchor in candidates]))
-    percepts, owners, scales = _candidates_as_percepts(candidates, matcher.uses_appearance & comparable)
+    percepts, owners, scales = _candidates_as_percepts(candidates, matcher.uses_appearance
+                                                       & _comparable(candidates, lost))
     anchors = AnchorColumns.from_anchors([lost])
     if lost.lost_after is not None:
         # Its last sighting is the one before it went missing, as for who may be it at all
@@ -103,6 +93,32 @@ def identity_scores(
     counted = _views_counted(candidates, owners, scales, smallest_view(lost) * far_view_ratio)
     views = np.bincount(owners, weights=counted, minlength=len(candidates))
     return np.bincount(owners, weights=per_view * counted, minlength=len(candidates)) / views
+
+
+def looks_compared(matcher: Matcher, candidates: Sequence[Anchor], lost: Anchor) -> np.ndarray:
+    """(len(candidates),) True where :func:`identity_scores` reads the candidate's look against the
+    lost anchor's: the matcher compares appearance, the two are comparable views of one extent (see
+    there) and both have appearance views. Where it is False the score is the fallback's: class,
+    place and time only, as the rules see any pair."""
+    if not candidates or not matcher.uses_appearance or lost.gallery is None or not len(lost.gallery):
+        return np.zeros(len(candidates), dtype=bool)
+    has_views = np.array([anchor.gallery is not None and len(anchor.gallery) > 0 for anchor in candidates])
+    return _comparable(candidates, lost) & has_views
+
+
+def _comparable(candidates: Sequence[Anchor], lost: Anchor) -> np.ndarray:
+    """(len(candidates),) whether each candidate's views and the lost anchor's show one extent."""
+    # A candidate that knows only a part of a large lost object (a view end-on, through a door)
+    # is compared without its look, as a partial percept is (matching_table.comparable_views);
+    # so is a lost anchor that knew only a part of what the candidate shows whole (a bicycle's
+    # end anchored first, the whole bicycle later: scenario suite, 4 December, a duplicate).
+    # So is a candidate whose box was joined from parts (:mod:`.parts`): its views are its parts',
+    # the whole object's look it never saw (the joined bicycle of `large_object_wheeled_away` was
+    # never taken by the search for the bicycle it was: scenario suite, network, 6 December 2026).
+    sizes = np.array([anchor.size for anchor in candidates])
+    return (comparable_views(sizes, None, [lost])[:, 0]
+            & comparable_views(np.asarray(lost.size).reshape(1, 3), None, candidates)[0]
+            & np.array([anchor.parts_fit is None for anchor in candidates]))
 
 
 def score_anywhere(matcher: Matcher, candidate: Anchor, lost: Anchor, far_view_ratio: float = 0.0) -> float:

@@ -39,7 +39,14 @@ from merlin2_sailor.anchoring.far_view import FarViewConfig, nearest_anchor, unr
 from merlin2_sailor.anchoring.frame_changes import AnchoringResult, FrameChanges
 from merlin2_sailor.anchoring.frame_registration import RegistrationConfig, read_frame, shift_percepts
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.identity_repair import Decision, IdentityRepair, Merge, RepairConfig, Unconfirmed
+from merlin2_sailor.anchoring.identity_repair import (
+    Decision,
+    IdentityRepair,
+    LookPending,
+    Merge,
+    RepairConfig,
+    Unconfirmed,
+)
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, sightings_doubled
 from merlin2_sailor.anchoring.match_explanation import matched_over
 from merlin2_sailor.anchoring.matcher import Matcher
@@ -554,4 +561,6 @@ def _involved(decision: Decision | Duplicate | Return | None) -> tuple[Anchor, .
         return decision.anchor, decision.newcomer
     if isinstance(decision, Unconfirmed):
         return decision.sought, decision.found
+    if isinstance(decision, LookPending):
+        return decision.sought, *decision.candidates
     return ()

@@ -60,7 +60,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, score_anywhere
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, looks_compared, score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import (
     ColourEvidenceConfig,
@@ -171,7 +171,21 @@ class Unconfirmed:
     reason: str
 
 
-Decision = Merge | Undecided | Unconfirmed
+@dataclass(frozen=True, slots=True, eq=False)
+class LookPending:
+    """A search met several anchors that may each be the MISSING ``sought`` and that the matching
+    function scores alike, but only because it has not seen the look of some of them: their views
+    were too partial or too far to compare, and their colour is not known. That is not yet a case of
+    look-alikes, which a closer view may settle: nothing is merged or said, ``sought`` records them
+    (``look_pending``) and the search looks on; a search that concludes with them still in question
+    cannot tell them apart (:meth:`IdentityRepair.conclude_search`)."""
+
+    sought: Anchor
+    candidates: tuple[Anchor, ...]
+    scores: tuple[float, ...]
+
+
+Decision = Merge | Undecided | Unconfirmed | LookPending
 
 
 class IdentityRepair:
@@ -298,7 +312,7 @@ class IdentityRepair:
             return None
         found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
         if found is None:
-            return self._left_in_question(sought, index)
+            return self._still_pending(sought, index) or self._left_in_question(sought, index)
         # It was possible when found (born after the lost one's last sighting, near enough to have
         # been carried there); a sighting of the lost anchor since, where the candidate stands, must
         # not make it impossible now: a far view of the wheeled bicycle took the lost anchor for a
@@ -316,6 +330,26 @@ class IdentityRepair:
                              f"{found.symbol} looks like {sought.symbol} but so does "
                              f"{', '.join(sorted(other.symbol for other in twins))}: it may be another copy")
         return Merge(sought, found, score, "found by search; no other copy anywhere searched", moved=True)
+
+    def _still_pending(self, sought: Anchor, index: AnchorIndex) -> Undecided | Unconfirmed | None:
+        """For a search that looked everywhere: the anchors it met without seeing their look
+        (``sought.look_pending``, :class:`LookPending`) that may still be the sought one (possible,
+        and taken for it by everything but where it stands). Several: :class:`Undecided`, since
+        nothing seen tells them apart; one: a find by look alone (:class:`Unconfirmed`: the search
+        goes to it and concludes there), as :meth:`_left_in_question` takes its one; none: None."""
+        pending = [anchor for symbol in sought.look_pending
+                   if (anchor := index.get(symbol)) is not None
+                   and self._possible(anchor, sought, include_missing=True)
+                   and self._anywhere(anchor, sought) >= self.match_threshold]
+        if not pending:
+            return None
+        if len(pending) == 1:
+            return Unconfirmed(sought, pending[0], self._anywhere(pending[0], sought),
+                               f"the only anchor the search met for {sought.symbol} without seeing its look "
+                               "that may still be it")
+        return Undecided((sought,), tuple(pending), tuple(self._anywhere(anchor, sought) for anchor in pending),
+                         f"{sought.symbol} may be any of {', '.join(a.symbol for a in pending)}: the search never "
+                         "saw enough of them to tell them apart")
 
     def _left_in_question(self, sought: Anchor, index: AnchorIndex) -> Undecided | Unconfirmed | None:
         """For a search that looked everywhere and found nothing: :class:`Undecided` naming the
@@ -542,6 +576,8 @@ class IdentityRepair:
         alike = [k for k in plausible if scores[k] > scores[best] - self.config.ambiguity_margin]
         if len(alike) > 1:
             found = tuple(candidates[k] for k in alike)
+            if moved and self._look_unseen(found, lost):
+                return LookPending(lost, found, tuple(float(scores[k]) for k in alike))
             return Undecided((lost,), found, tuple(float(scores[k]) for k in alike),
                              f"{lost.symbol} may be any of {', '.join(a.symbol for a in found)}: they look alike")
         chosen = candidates[best]
@@ -559,6 +595,24 @@ class IdentityRepair:
             return Undecided(missing, (chosen,), (float(scores[best]), *rival_scores),
                              f"{chosen.symbol} may be any of {', '.join(a.symbol for a in missing)}: they look alike")
         return Merge(lost, chosen, float(scores[best]), reason, moved)
+
+    def _look_unseen(self, candidates: Sequence[Anchor], lost: Anchor) -> bool:
+        """Whether the look of any of ``candidates`` is still unseen for ``lost``: the matching
+        function did not compare it (:func:`~.anchor_comparison.looks_compared`) and the colours of
+        the two are not both known, so nothing the robot saw of it could have ruled it out.
+
+        Why a search defers such a case: two bicycles 0.3 m apart in a room the robot had only seen
+        through doorways, each known from end-on views cut by the door frame, scored 1.00 each for
+        the wheeled bicycle (the fallback's class, place and time), and the search ended at its first
+        stop saying they looked alike, before the stop from which both were in plain view (probe
+        scenario, a bicycle of another look beside the wheeled one, network, seed 0, 7 December
+        2026). With neither appearance nor colour evidence (the rules, colours off) no view ever
+        shows a look, and nothing is worth waiting for."""
+        if not self.matcher.uses_appearance and self.colour.minimum_views == 0:
+            return False
+        compared = looks_compared(self.matcher, candidates, lost)
+        return any(not seen and not colours_agree(candidate.colour, lost.colour, self.colour)
+                   for candidate, seen in zip(candidates, compared, strict=True))
 
     def _rivals(
         self, candidate: Anchor, lost: Anchor, index: AnchorIndex, place_of: Callable[[Anchor], SearchedDisc],

@@ -16,7 +16,7 @@ from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.events import AnchorEventKind
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
-from merlin2_sailor.anchoring.identity_repair import Decision, Merge, Unconfirmed
+from merlin2_sailor.anchoring.identity_repair import Decision, LookPending, Merge, Unconfirmed
 from merlin2_sailor.anchoring.observation import drop_expectation
 from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS
 from merlin2_sailor.anchoring.parts import Parts, is_part, reaches_past
@@ -36,6 +36,7 @@ def withdraw_stale_ambiguities(index: AnchorIndex) -> None:
             anchor.indistinguishable_from = ()
         if anchor.found_by_look_alone and anchor.found_by_look_alone not in index:
             anchor.found_by_look_alone = ""
+        anchor.look_pending = tuple(symbol for symbol in anchor.look_pending if symbol in index)
 
 
 def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusion: FusionConfig) -> None:
@@ -142,6 +143,11 @@ def apply_decision(
         # Nothing merged, nothing said yet: the search looks on (see identity_repair).
         decision.sought.found_by_look_alone = decision.found.symbol
         return
+    if isinstance(decision, LookPending):
+        # Nothing merged, nothing said yet: a closer view may tell them apart (see identity_repair).
+        decision.sought.look_pending = tuple(dict.fromkeys(
+            (*decision.sought.look_pending, *(candidate.symbol for candidate in decision.candidates))))
+        return
     if not isinstance(decision, Merge):
         involved = [anchor.symbol for anchor in (*decision.lost, *decision.found)]
         for lost in decision.lost:
@@ -165,6 +171,7 @@ def apply_decision(
     drop_expectation(kept)
     kept.indistinguishable_from = ()
     kept.found_by_look_alone = ""
+    kept.look_pending = ()
     # A merged anchor that is missing leaves the kept one missing, on its clock: the object
     # was last seen under that symbol, and seeing it again confirms it as usual.
     kept.state = AnchorState.MISSING if still_missing else AnchorState.CONFIRMED

@@ -68,6 +68,7 @@ def reacquire(
         anchor.missing_since = missing_since  # not back yet: still on the clock that forgets it
     else:
         anchor.indistinguishable_from = ()  # seen as itself: its identity is decided again
+        anchor.look_pending = ()
         if searching:
             resolve_expectation(anchor, percept, changes, expectation_tolerance)
     changes.reacquired.append(anchor)

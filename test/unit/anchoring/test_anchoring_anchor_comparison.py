@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring.anchor import Anchor
-from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
+from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores, looks_compared
 from merlin2_sailor.anchoring.features import FeatureConfig, PairFeatures
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
 from merlin2_sailor.anchoring.matcher import Matcher
+from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 from merlin2_sailor.contract.percept import BoundingBox2D, Percept
 
 
@@ -136,3 +137,24 @@ def test_a_matcher_without_appearance_scores_as_before():
         before = identity_scores(RuleMatcher(), candidates, lost, disc)
         assert identity_scores(RuleMatcher(), candidates, lost, disc, far_view_ratio=0.5) == pytest.approx(before)
         assert (before > 0.0).all()
+
+
+def test_a_look_is_compared_only_where_both_have_views_of_one_extent_and_the_matcher_reads_looks():
+    """:func:`looks_compared` says which scores read the candidate's look: none for a matcher without
+    appearance, none for a candidate or lost anchor without views, none for a view of a part of the
+    lost object (a bicycle's end seen through a door), the rest yes."""
+    lost = anchor("bicycle_1", [[1.0, 0.0]])
+    lost.size, lost.whole_views = np.array([0.35, 1.6, 1.0]), 10
+    whole = anchor("bicycle_2", [[1.0, 0.0]], stamp=5.0)
+    whole.size = np.array([0.36, 1.55, 0.98])
+    part = anchor("bicycle_3", [[1.0, 0.0]], stamp=5.0)
+    part.size = np.array([0.36, 0.2, 0.98])
+    no_views = anchor("bicycle_4", [[1.0, 0.0]], stamp=5.0)
+    no_views.size = whole.size.copy()
+    no_views.gallery = None
+    candidates = [whole, part, no_views]
+    assert looks_compared(AppearanceOnly(), candidates, lost).tolist() == [True, False, False]
+    assert looks_compared(RuleMatcher(), candidates, lost).tolist() == [False, False, False]
+    blind = anchor("bicycle_1", [[1.0, 0.0]])
+    blind.size, blind.whole_views, blind.gallery = lost.size, lost.whole_views, None
+    assert looks_compared(AppearanceOnly(), candidates, blind).tolist() == [False, False, False]

@@ -990,3 +990,46 @@ def test_a_view_of_the_anchors_object_lit_otherwise_is_not_held_apart_from_it(hu
                         colour=book_colour((hue + 6) % HUE_BINS, *turned))
     result = anchoring.process([maker.percept(other, 120.0)], camera_view(), 120.0)
     assert result.percept_symbols == ("",) and result.unresolved == ("book_1",)
+
+
+@pytest.mark.parametrize(("sought_hue", "other_hue", "seed"), [(RED, GREEN, 1), (BLUE, RED, 2), (GREEN, 3, 3)])
+def test_a_search_that_has_not_seen_the_look_of_what_it_met_looks_on_and_a_closer_view_decides(
+    sought_hue: int, other_hue: int, seed: int
+) -> None:
+    """A search meets two mugs it has seen only too far to know their colours: nothing tells them
+    apart yet, but nothing says they look alike either. It says nothing and looks on (the anchor
+    records them); seen closer, the one of another colour is ruled out and the other is the sought
+    one, taken when the search concludes. Had no closer view come, concluding would say that it
+    cannot tell them apart, after a restart too. (Before: "they look alike" at the first stop, and
+    the search ended there.)"""
+    sought = SceneObject("sought", "cup", KITCHEN, colour=mug_colour(sought_hue))
+    moved_to, other_at = (1.3, 5.9, 0.8), (1.8, 6.2, 0.8)
+    colourless = [SceneObject("sought", "cup", moved_to), SceneObject("other", "cup", other_at)]
+    coloured = [SceneObject("sought", "cup", moved_to, colour=mug_colour(sought_hue)),
+                SceneObject("other", "cup", other_at, colour=mug_colour(other_hue))]
+    outcomes = {}
+    for closer in (True, False):
+        anchoring, maker = rules(), PerceptMaker(seed=seed)
+        see(anchoring, maker, [sought], 0.0)
+        see(anchoring, maker, [], 1.0, frames=1)
+        see(anchoring, maker, colourless, WALKED_THERE, camera=False)
+        symbol_at = {tuple(moved_to): None, tuple(other_at): None}
+        for place in symbol_at:
+            symbol_at[place] = next(anchor.symbol for anchor in anchoring.anchors if anchor.symbol != "cup_1"
+                                    and np.linalg.norm(anchor.position[:2] - np.array(place[:2])) < 0.2)
+        moved_symbol, other_symbol = symbol_at[tuple(moved_to)], symbol_at[tuple(other_at)]
+        assert kinds(search(anchoring, "cup_1", WALKED_THERE + 1.0)) == []
+        assert set(anchoring.get("cup_1").look_pending) == {moved_symbol, other_symbol}
+        assert anchoring.get("cup_1").indistinguishable_from == ()
+        if closer:
+            see(anchoring, maker, coloured, WALKED_THERE + 2.0, frames=8, camera=False)
+            assert kinds(search(anchoring, "cup_1", WALKED_THERE + 3.0)) == []
+        else:  # what the search met survives a restart
+            restarted = rules()
+            restarted.restore(json.loads(json.dumps(anchoring.snapshot())))
+            assert restarted.get("cup_1").look_pending == anchoring.get("cup_1").look_pending
+            anchoring = restarted
+        outcomes[closer] = concluded(anchoring, "cup_1"), anchoring.get("cup_1").indistinguishable_from
+    assert outcomes[True] == ([(AnchorEventKind.FORGOTTEN, moved_symbol), (AnchorEventKind.CONFIRMED, "cup_1")], ())
+    assert outcomes[False][0] == [(AnchorEventKind.AMBIGUOUS, "cup_1")]
+    assert set(outcomes[False][1]) == {moved_symbol, other_symbol}
