@@ -273,11 +273,9 @@ def test_one_box_around_two_neighbours_does_not_make_their_views_its_parts(maker
         mug_anchor.symbol]
 
 
-def test_a_search_confirmed_by_a_partial_view_puts_the_anchor_where_it_was_seen(maker) -> None:
-    """Perception outranks expectation: a search put the missing bicycle's anchor in the middle of
-    the searched disc, and the views that find it there are of a part (through a door frame). A
-    partial view does not move an anchor seen whole, but the disc's middle is no place the object
-    was seen: once the search is confirmed, the anchor is where the view saw it."""
+def searched_bicycle(maker: PerceptMaker, searched_at: tuple[float, float, float]) -> tuple[Anchoring, Anchor]:
+    """The bicycle seen whole four times, then missing, and sought by a search 1.5 m around
+    ``searched_at``, which puts its anchor there until a view confirms it."""
     anchoring = Anchoring()
     camera = camera_view()
     for frame in range(4):
@@ -285,7 +283,16 @@ def test_a_search_confirmed_by_a_partial_view_puts_the_anchor_where_it_was_seen(
                           partial=[False])
     bicycle = anchoring.get("bicycle_1")
     bicycle.state, bicycle.missing_since, bicycle.lost_after = AnchorState.MISSING, 1.0, 0.3
-    anchoring.expect("bicycle_1", Expectation.at(np.array((3.0, 2.0, 0.5)), 5.0, "hall", "find_object", 1.5))
+    anchoring.expect("bicycle_1", Expectation.at(np.array(searched_at), 5.0, "hall", "find_object", 1.5))
+    return anchoring, bicycle
+
+
+def test_a_search_confirmed_by_a_partial_view_puts_the_anchor_where_it_was_seen(maker) -> None:
+    """Perception outranks expectation: a search put the missing bicycle's anchor in the middle of
+    the searched disc, and the views that find it there are of a part (through a door frame). A
+    partial view does not move an anchor seen whole, but the disc's middle is no place the object
+    was seen: once the search is confirmed, the anchor is where the view saw it."""
+    anchoring, bicycle = searched_bicycle(maker, (3.0, 2.0, 0.5))
     assert bicycle.position[:2] == pytest.approx((3.0, 2.0))
     part_seen = (3.0, 2.6, 0.5)
     for frame in range(12):
@@ -305,14 +312,7 @@ def test_a_search_confirmed_by_a_view_of_the_near_face_puts_the_anchor_beyond_it
     """Seen end-on, a bicycle the search sought shows only its near face: a box no test saw cut,
     0.3 m deep where the bicycle is 1.6 m long. The rest is beyond the face, away from the camera,
     so its middle is half the shortfall farther along the line of sight, from whichever side."""
-    anchoring = Anchoring()
-    camera = camera_view()
-    for frame in range(4):
-        anchoring.process([view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX)], camera, frame * 0.1,
-                          partial=[False])
-    bicycle = anchoring.get("bicycle_1")
-    bicycle.state, bicycle.missing_since, bicycle.lost_after = AnchorState.MISSING, 1.0, 0.3
-    anchoring.expect("bicycle_1", Expectation.at(np.array((3.0, 3.0, 0.5)), 5.0, "hall", "find_object", 1.5))
+    anchoring, bicycle = searched_bicycle(maker, (3.0, 3.0, 0.5))
     moved_to = np.array((3.0, 3.0))
     for frame in range(12):
         stamp = 6.0 + frame * 0.1
