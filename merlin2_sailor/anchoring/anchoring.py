@@ -46,6 +46,7 @@ from merlin2_sailor.anchoring.identity_repair import (
     Merge,
     RepairConfig,
     Unconfirmed,
+    Undecided,
 )
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, sightings_doubled
 from merlin2_sailor.anchoring.match_explanation import matched_over
@@ -563,4 +564,10 @@ def _involved(decision: Decision | Duplicate | Return | None) -> tuple[Anchor, .
         return decision.sought, decision.found
     if isinstance(decision, LookPending):
         return decision.sought, *decision.candidates
+    if isinstance(decision, Undecided):
+        # A twin that this frame merged into the found anchor (a second anchor of one mug, merged
+        # as it reappeared) was no copy: "cup_8 looks like cup_1 but so does cup_14", with cup_14
+        # merged into cup_8 a moment before, left the search for the moved mug undecided for good
+        # (test_mission_end_to_end, network, CI, 7 December 2026).
+        return *decision.lost, *decision.found, *decision.also
     return ()

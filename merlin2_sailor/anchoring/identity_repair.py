@@ -155,6 +155,9 @@ class Undecided:
     found: tuple[Anchor, ...]
     scores: tuple[float, ...]
     reason: str
+    also: tuple[Anchor, ...] = ()
+    """Other anchors the case rests on (the twins that make a find doubtful): if one of them is
+    merged or forgotten before the case is carried out, the case no longer holds."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -279,7 +282,8 @@ class IdentityRepair:
         return Undecided((lost,), tuple(named), (merge.score,),
                          f"{found.symbol} looks like {lost.symbol} but so does "
                          f"{', '.join(sorted(other.symbol for other in twins))}, and the camera had not watched "
-                         "where it stands before it was seen: it may be another twin that stood there all along")
+                         "where it stands before it was seen: it may be another twin that stood there all along",
+                         also=tuple(twins))
 
     def _twins(self, lost: Anchor, index: AnchorIndex, besides: Anchor) -> list[Anchor]:
         """Other anchors (than ``lost`` and ``besides``) whose colour agrees with the lost one's, both

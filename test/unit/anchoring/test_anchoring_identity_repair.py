@@ -25,7 +25,11 @@ import numpy as np
 import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, Expectation
+from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_comparison import SearchedDisc, identity_scores
+from merlin2_sailor.anchoring.anchoring import _involved as involved
+from merlin2_sailor.anchoring.fusion import FusionConfig
+from merlin2_sailor.anchoring.identity_repair import Undecided
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
 
@@ -489,3 +493,19 @@ def test_a_search_for_an_anchor_perception_has_confirmed_leaves_it_where_it_was_
     anchor = anchoring.get("cup_1")
     assert anchor.state is AnchorState.CONFIRMED and anchor.expectation is None
     np.testing.assert_allclose(anchor.position, before)
+
+
+def test_a_case_that_rests_on_an_anchor_merged_earlier_in_the_frame_is_not_carried_out() -> None:
+    """A frame's decisions are made first and carried out in turn, each only while every anchor it
+    involves is still anchored: an undecided case involves its lost and found anchors and the twins
+    it rests on, so "cup_2 looks like cup_1 but so does cup_3" is dropped once cup_3 was merged
+    into cup_2 as the same mug reappearing (CI, 7 December 2026: the search for the moved mug
+    stayed undecided for good)."""
+    maker = PerceptMaker(seed=4)
+    lost, found, twin, other = (
+        Anchor.from_percept(symbol, maker.percept(SceneObject(symbol, "cup", (x, 0.0, 0.8)), 0.0), None, FusionConfig())
+        for symbol, x in (("cup_1", 0.0), ("cup_2", 2.0), ("cup_3", 2.05), ("cup_4", 4.0)))
+    case = Undecided((lost,), (found,), (0.8,), "cup_2 looks like cup_1 but so does cup_3", also=(twin,))
+    assert {anchor.symbol for anchor in involved(case)} == {"cup_1", "cup_2", "cup_3"}
+    plain = Undecided((lost,), (found, other), (0.8, 0.8), "cup_1 may be any of cup_2, cup_4")
+    assert {anchor.symbol for anchor in involved(plain)} == {"cup_1", "cup_2", "cup_4"}
