@@ -185,7 +185,6 @@ class LookPending:
 
     sought: Anchor
     candidates: tuple[Anchor, ...]
-    scores: tuple[float, ...]
 
 
 Decision = Merge | Undecided | Unconfirmed | LookPending
@@ -341,17 +340,19 @@ class IdentityRepair:
         and taken for it by everything but where it stands). Several: :class:`Undecided`, since
         nothing seen tells them apart; one: a find by look alone (:class:`Unconfirmed`: the search
         goes to it and concludes there), as :meth:`_left_in_question` takes its one; none: None."""
-        pending = [anchor for symbol in sought.look_pending
-                   if (anchor := index.get(symbol)) is not None
-                   and self._possible(anchor, sought, include_missing=True)
-                   and self._anywhere(anchor, sought) >= self.match_threshold]
+        possible = [anchor for symbol in sought.look_pending
+                    if (anchor := index.get(symbol)) is not None
+                    and self._possible(anchor, sought, include_missing=True)]
+        scored = [(anchor, self._anywhere(anchor, sought)) for anchor in possible]
+        pending = [anchor for anchor, score in scored if score >= self.match_threshold]
+        scores = tuple(score for _, score in scored if score >= self.match_threshold)
         if not pending:
             return None
         if len(pending) == 1:
-            return Unconfirmed(sought, pending[0], self._anywhere(pending[0], sought),
+            return Unconfirmed(sought, pending[0], scores[0],
                                f"the only anchor the search met for {sought.symbol} without seeing its look "
                                "that may still be it")
-        return Undecided((sought,), tuple(pending), tuple(self._anywhere(anchor, sought) for anchor in pending),
+        return Undecided((sought,), tuple(pending), scores,
                          f"{sought.symbol} may be any of {', '.join(a.symbol for a in pending)}: the search never "
                          "saw enough of them to tell them apart")
 
@@ -581,7 +582,7 @@ class IdentityRepair:
         if len(alike) > 1:
             found = tuple(candidates[k] for k in alike)
             if moved and self._look_unseen(found, lost):
-                return LookPending(lost, found, tuple(float(scores[k]) for k in alike))
+                return LookPending(lost, found)
             return Undecided((lost,), found, tuple(float(scores[k]) for k in alike),
                              f"{lost.symbol} may be any of {', '.join(a.symbol for a in found)}: they look alike")
         chosen = candidates[best]
