@@ -293,6 +293,32 @@ class IdentityRepair:
                 and colours_agree(other.colour, lost.colour, self.colour)
                 and self._anywhere(other, lost) >= self.match_threshold]
 
+    def _also_possible(self, sought: Anchor, index: AnchorIndex, besides: Anchor) -> list[Anchor]:
+        """Anchors other than ``besides`` that may as well be the MISSING ``sought``, for a search
+        that has looked everywhere: possible by time, place and colour (:meth:`_possible`), taken
+        for it by the matching function by everything but where they stand, and, scored where they
+        stand as a search scores (:meth:`_not_firmly_rejected`), no firm rejection. Their colour
+        need not be known: a stop that meets such an anchor looks on, since a later view may
+        show its colour; a concluding search has no later view, and a candidate it could not rule
+        out is still a candidate.
+
+        Measured: the kitchen's dog moved to the living room, never watched, was anchored anew
+        there, seen from the doorway with its colour not yet known (the network took it for the
+        lost dog, place left out), and the search concluded on the bedroom's twin, found by look
+        alone, as the dog (`large_object_moved`, network, seed 2, 7 December 2026)."""
+        return [other for other in index.of_class(sought.class_name)
+                if other is not besides and self._possible(other, sought, include_missing=True)
+                and self._not_firmly_rejected(other, sought) is not None]
+
+    def _not_firmly_rejected(self, candidate: Anchor, sought: Anchor) -> float | None:
+        """The search's score of ``candidate`` where it stands (in a searched disc around it), where
+        that is no firm rejection (the far-view floor) and the matching function takes it for
+        ``sought`` by everything but where it stands; else None."""
+        searched = float(self._scores([candidate], sought, SearchedDisc(candidate.position, self.search_tolerance))[0])
+        if searched < self.firm_rejection or self._anywhere(candidate, sought) < self.match_threshold:
+            return None
+        return searched
+
     def _seen_elsewhere(self, sought: Anchor, found: Anchor) -> bool:
         """Whether ``sought`` was back (confirmed again, then lost) since ``found`` was first seen,
         away from where ``found`` stands (farther than the larger footprint of the two, plus the
@@ -307,8 +333,9 @@ class IdentityRepair:
     def conclude_search(self, sought: Anchor, index: AnchorIndex) -> Decision | None:
         """A search that looked everywhere takes the candidate it found by look alone
         (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
-        of it is anchored by now (:class:`Undecided`) or the candidate is gone or no longer
-        possible (None: nothing to take). Without a candidate, an :class:`Undecided` when the
+        of it is anchored by now or another anchor may as well be it (:meth:`_also_possible`), then
+        :class:`Undecided`, or the candidate is gone or no longer possible (None: nothing to
+        take). Without a candidate, an :class:`Undecided` when the
         search left anchors in question, or an :class:`Unconfirmed` (a candidate to conclude on)
         when it left one alone and no copy (:meth:`_left_in_question`)."""
         if sought.state is not AnchorState.MISSING or sought.indistinguishable_from:
@@ -332,6 +359,12 @@ class IdentityRepair:
             return Undecided((sought,), (found, *twins), (score,),
                              f"{found.symbol} looks like {sought.symbol} but so does "
                              f"{', '.join(sorted(other.symbol for other in twins))}: it may be another copy")
+        others = [other for other in self._also_possible(sought, index, besides=found) if other is not sought]
+        if others:
+            return Undecided((sought,), (found, *others), (score,),
+                             f"{found.symbol} looks like {sought.symbol}, but "
+                             f"{', '.join(sorted(other.symbol for other in others))} may be it as well: nothing "
+                             "the search saw rules them out")
         return Merge(sought, found, score, "found by search; no other copy anywhere searched", moved=True)
 
     def _still_pending(self, sought: Anchor, index: AnchorIndex) -> Undecided | Unconfirmed | None:
@@ -387,9 +420,8 @@ class IdentityRepair:
             if not (self._possible(candidate, sought, include_missing=True)
                     and colours_agree(candidate.colour, sought.colour, self.colour)):
                 continue
-            searched = float(self._scores([candidate], sought, SearchedDisc(candidate.position,
-                                                                              self.search_tolerance))[0])
-            if searched >= self.firm_rejection and self._anywhere(candidate, sought) >= self.match_threshold:
+            searched = self._not_firmly_rejected(candidate, sought)
+            if searched is not None:
                 in_question.append((candidate, searched))
         if not in_question:
             return None
