@@ -177,11 +177,12 @@ class Unconfirmed:
 @dataclass(frozen=True, slots=True, eq=False)
 class LookPending:
     """A search met several anchors that may each be the MISSING ``sought`` and that the matching
-    function scores alike, but only because it has not seen the look of some of them: their views
-    were too partial or too far to compare, and their colour is not known. That is not yet a case of
-    look-alikes, which a closer view may settle: nothing is merged or said, ``sought`` records them
-    (``look_pending``) and the search looks on; a search that concludes with them still in question
-    cannot tell them apart (:meth:`IdentityRepair.conclude_search`)."""
+    function scores alike, or one that it scores alike for ``sought`` and for other MISSING anchors,
+    but only because it has not seen the look of some of them: their views were too partial or too
+    far to compare, and their colour is not known. That is not yet a case of look-alikes, which a
+    closer view may settle: nothing is merged or said, ``sought`` records them (``look_pending``)
+    and the search looks on; a search that concludes with them still in question cannot tell them
+    apart (:meth:`IdentityRepair.conclude_search`)."""
 
     sought: Anchor
     candidates: tuple[Anchor, ...]
@@ -372,7 +373,9 @@ class IdentityRepair:
         (``sought.look_pending``, :class:`LookPending`) that may still be the sought one (possible,
         and taken for it by everything but where it stands). Several: :class:`Undecided`, since
         nothing seen tells them apart; one: a find by look alone (:class:`Unconfirmed`: the search
-        goes to it and concludes there), as :meth:`_left_in_question` takes its one; none: None."""
+        goes to it and concludes there), as :meth:`_left_in_question` takes its one, unless another
+        MISSING anchor may as well be it (:meth:`_rivals`, place left out: :class:`Undecided`);
+        none: None."""
         possible = [anchor for symbol in sought.look_pending
                     if (anchor := index.get(symbol)) is not None
                     and self._possible(anchor, sought, include_missing=True)]
@@ -382,7 +385,14 @@ class IdentityRepair:
         if not pending:
             return None
         if len(pending) == 1:
-            return Unconfirmed(sought, pending[0], scores[0],
+            [anchor] = pending
+            rivals = self._rivals(anchor, sought, index, lambda _: SearchedDisc(anchor.position, 0.0), near_only=False)
+            if rivals:
+                missing = (sought, *rivals)
+                return Undecided(missing, (anchor,), scores,
+                                 f"{anchor.symbol} may be any of {', '.join(a.symbol for a in missing)}: the search "
+                                 "never saw enough of it to tell")
+            return Unconfirmed(sought, anchor, scores[0],
                                f"the only anchor the search met for {sought.symbol} without seeing its look "
                                "that may still be it")
         return Undecided((sought,), tuple(pending), scores,
@@ -629,6 +639,13 @@ class IdentityRepair:
                 # network, 5 December 2026, where "cannot be told apart" ended the mission).
                 return None
             missing = (lost, *rivals)
+            if moved and any(self._look_unseen([chosen], anchor) for anchor in missing):
+                # Which lost object it is, a look would tell: the search looks on (two bicycles
+                # known from end-on views through doorways, one wheeled beside the other, each
+                # anchor scored 1.00 by class, place and time alone: `bicycle_wheeled_beside_another`,
+                # network, seed 0, 7 December 2026, said "cannot tell" at a stop before the one
+                # from which the new anchor was in plain view).
+                return LookPending(lost, (chosen,))
             return Undecided(missing, (chosen,), (float(scores[best]), *rival_scores),
                              f"{chosen.symbol} may be any of {', '.join(a.symbol for a in missing)}: they look alike")
         return Merge(lost, chosen, float(scores[best]), reason, moved)

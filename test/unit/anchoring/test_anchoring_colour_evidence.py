@@ -1033,3 +1033,52 @@ def test_a_search_that_has_not_seen_the_look_of_what_it_met_looks_on_and_a_close
     assert outcomes[True] == ([(AnchorEventKind.FORGOTTEN, moved_symbol), (AnchorEventKind.CONFIRMED, "cup_1")], ())
     assert outcomes[False][0] == [(AnchorEventKind.AMBIGUOUS, "cup_1")]
     assert set(outcomes[False][1]) == {moved_symbol, other_symbol}
+
+
+@pytest.mark.parametrize(("sought_hue", "rival_hue", "seed"), [(RED, GREEN, 4), (BLUE, RED, 5), (RED, RED, 6),
+                                                              (GREEN, GREEN, 7)])
+def test_a_newcomer_that_may_be_either_of_two_lost_mugs_is_left_to_a_view_of_its_look(
+    sought_hue: int, rival_hue: int, seed: int
+) -> None:
+    """Two mugs gone from the kitchen, one mug met by the search, seen only too far to know its
+    colour: which lost mug it is (if either), nothing seen tells, but nothing says they look alike
+    either. The search says nothing and looks on; seen closer, of the sought mug's colour, it is the
+    sought one where the other lost mug is of another colour, and where both lost mugs are of its
+    colour it cannot be told which. Had no closer view come, concluding says that it cannot tell
+    which lost mug it is, naming both. (Before: "they look alike" at the first stop, both lost
+    anchors undecided for good: `bicycle_wheeled_beside_another`, network, seed 0, 7 December 2026,
+    two bicycles known only from end-on views.)"""
+    sought = SceneObject("sought", "cup", KITCHEN, colour=mug_colour(sought_hue))
+    rival = SceneObject("rival", "cup", (2.0, -0.5, 0.8), colour=mug_colour(rival_hue))
+    moved_to = (1.3, 5.9, 0.8)
+    outcomes = {}
+    for closer in (True, False):
+        anchoring, maker = rules(), PerceptMaker(seed=seed)
+        see(anchoring, maker, [sought, rival], 0.0)
+        rival_symbol = next(a.symbol for a in anchoring.anchors if a.position[1] < 0.0)
+        sought_symbol = next(a.symbol for a in anchoring.anchors if a.symbol != rival_symbol)
+        see(anchoring, maker, [], 1.0, frames=1)
+        assert {a.state for a in anchoring.anchors} == {AnchorState.MISSING}
+        see(anchoring, maker, [SceneObject("sought", "cup", moved_to)], WALKED_THERE, camera=False)
+        [newcomer] = [a.symbol for a in anchoring.anchors if a.symbol not in (sought_symbol, rival_symbol)]
+        assert kinds(search(anchoring, sought_symbol, WALKED_THERE + 1.0)) == []
+        assert anchoring.get(sought_symbol).look_pending == (newcomer,)
+        assert anchoring.get(sought_symbol).indistinguishable_from == ()
+        assert anchoring.get(rival_symbol).indistinguishable_from == ()
+        if closer:
+            see(anchoring, maker, [SceneObject("sought", "cup", moved_to, colour=mug_colour(sought_hue))],
+                WALKED_THERE + 2.0, frames=8, camera=False)
+            search(anchoring, sought_symbol, WALKED_THERE + 3.0)
+            if sought_hue == rival_hue:  # now they do look alike (said as the colour became known)
+                assert set(anchoring.get(sought_symbol).indistinguishable_from) == {rival_symbol, newcomer}
+                assert set(anchoring.get(rival_symbol).indistinguishable_from) == {sought_symbol, newcomer}
+                continue
+            assert recorded(anchoring, sought_symbol) == (AnchorState.MISSING, newcomer)
+            assert anchoring.get(rival_symbol).indistinguishable_from == ()
+        outcomes[closer] = concluded(anchoring, sought_symbol), anchoring.get(sought_symbol).indistinguishable_from
+    if sought_hue != rival_hue:
+        assert outcomes[True] == ([(AnchorEventKind.FORGOTTEN, newcomer), (AnchorEventKind.CONFIRMED, sought_symbol)],
+                                  ())
+    events, undecided = outcomes[False]
+    assert set(events) == {(AnchorEventKind.AMBIGUOUS, sought_symbol), (AnchorEventKind.AMBIGUOUS, rival_symbol)}
+    assert set(undecided) == {rival_symbol, newcomer}
