@@ -335,10 +335,11 @@ class IdentityRepair:
         """A search that looked everywhere takes the candidate it found by look alone
         (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
         of it is anchored by now or another anchor may as well be it (:meth:`_also_possible`), then
-        :class:`Undecided`, or the candidate is gone or no longer possible (None: nothing to
-        take). Without a candidate, an :class:`Undecided` when the
-        search left anchors in question, or an :class:`Unconfirmed` (a candidate to conclude on)
-        when it left one alone and no copy (:meth:`_left_in_question`)."""
+        :class:`Undecided`, or the candidate is gone or no longer possible (None: nothing to take).
+        Without a candidate, what the search met without seeing its look (:meth:`_still_pending`),
+        else an :class:`Undecided` when the search left anchors in question, or an
+        :class:`Unconfirmed` (a candidate to conclude on) when it left one alone and no copy
+        (:meth:`_left_in_question`)."""
         if sought.state is not AnchorState.MISSING or sought.indistinguishable_from:
             return None
         found = index.get(sought.found_by_look_alone) if sought.found_by_look_alone else None
@@ -360,7 +361,7 @@ class IdentityRepair:
             return Undecided((sought,), (found, *twins), (score,),
                              f"{found.symbol} looks like {sought.symbol} but so does "
                              f"{', '.join(sorted(other.symbol for other in twins))}: it may be another copy")
-        others = [other for other in self._also_possible(sought, index, besides=found) if other is not sought]
+        others = self._also_possible(sought, index, besides=found)
         if others:
             return Undecided((sought,), (found, *others), (score,),
                              f"{found.symbol} looks like {sought.symbol}, but "
