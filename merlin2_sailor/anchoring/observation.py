@@ -53,10 +53,12 @@ def reacquire(
         resolve_expectation(anchor, percept, changes, expectation_tolerance)
     was_missing = anchor.state is AnchorState.MISSING
     missing_since = anchor.missing_since
-    # Whole by the camera's tests, yet less of the object than its whole views showed: its near
-    # face, the rest beyond it along the line of sight.
-    near_face_only = not partial and smaller_than_known(percept, anchor)
-    partial = partial or near_face_only
+    # Less of the object than its whole views showed: seen from its end, its near face, the rest
+    # beyond it along the line of sight. Whole by the camera's tests, such a view is partial all
+    # the same; cut by them (a door frame, the image's edge), it is a near face too where it is
+    # seen end-on: a cut takes from the view's width, never from its depth.
+    shows_less = smaller_than_known(percept, anchor)
+    partial = partial or shows_less
     before_sighting(anchor, percept, lifecycle)
     # A MISSING anchor's sighting too few to bring it back is no evidence of what the object looks
     # like (it may be a false box, or a look-alike, in a searched disc): its colour and look join
@@ -74,7 +76,7 @@ def reacquire(
         anchor.look_pending = ()
         if searching:
             resolve_expectation(anchor, percept, changes, expectation_tolerance,
-                                centre_beyond_near_face(percept, anchor.size) if near_face_only else None)
+                                centre_beyond_near_face(percept, anchor.size) if shows_less else None)
     changes.reacquired.append(anchor)
     changes.event(
         AnchorEventKind.REACQUIRED, anchor.symbol, was_missing=was_missing, tracker_id=percept.tracker_id,

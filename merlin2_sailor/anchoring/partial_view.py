@@ -91,17 +91,19 @@ def smaller_than_known(percept: Percept, anchor: Anchor) -> bool:
 
 
 def centre_beyond_near_face(percept: Percept, known_size: np.ndarray) -> np.ndarray:
-    """Where a large object's centre lies, seen whole by the camera's tests (not cut by the image's
-    edge nor an occluder) yet shorter than its known extent along the line of sight: the camera
-    measured the face nearest it, and the rest of the object lies beyond, away from the viewpoint.
-    Boxes are upright and aligned with the world's axes, so the rest lies along the horizontal axis
-    nearest the line of sight: the centre is the view's, moved along that axis, away from the
-    viewpoint, by half the view's shortfall on it. Unchanged without a viewpoint or a shortfall (a
-    view across an object is as long as the object, or cut, which the camera's tests say).
+    """Where a large object's centre lies, seen shorter than its known extent along the line of
+    sight: the camera measured the face nearest it, and the rest of the object lies beyond, away
+    from the viewpoint. Boxes are upright and aligned with the world's axes, so the rest lies along
+    the horizontal axis nearest the line of sight: the centre is the view's, moved along that axis,
+    away from the viewpoint, by half the view's shortfall on it. Unchanged without a viewpoint or a
+    shortfall (a view across an object is as deep as the object). Whether the camera's tests saw
+    the view cut does not matter: a door frame or the image's edge cuts a view's width, not its
+    depth.
 
     Measured: a bicycle 1.6 m long wheeled into the living room, seen from there only end-on, was
     found by a search and placed at its near end, 0.75-0.87 m from its middle, in three seeds of
-    `bicycle_wheeled_beside_another` (network, 7 December 2026)."""
+    `bicycle_wheeled_beside_another` (network, 7 December 2026); with views no test saw cut first,
+    then (seed 0 again, and seed 2) with views the door frame cut."""
     centre = np.asarray(percept.position, dtype=np.float64).copy()
     if percept.viewpoint is None:
         return centre
