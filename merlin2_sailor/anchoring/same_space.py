@@ -13,8 +13,7 @@ three of the five in `removed` (rules) were such pairs (overlap 0.6-1.0).
 
 No merge without evidence: with a matcher that reads appearance, the matching function must also
 take the younger anchor, its place left out (both stand on one spot by construction), for the
-older one (:func:`~.anchor_comparison.score_anywhere`, as the other repairs ask), having compared
-their looks or known both colours to agree (:func:`looks_alike`). Overlap and
+older one (:func:`~.anchor_comparison.score_anywhere`, as the other repairs ask). Overlap and
 colour alone let a red book whose anchor slid onto its blue neighbour's missing one be merged
 into it (`crowded_shelf`, network, seed 0, 3 December: overlap 0.68, neither colour known from
 3-4 m, and the mission's target symbol merged away). The rules read no appearance and are judged
@@ -47,9 +46,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
-from merlin2_sailor.anchoring.anchor_comparison import looks_compared, score_anywhere
+from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
-from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ, colours_agree
+from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
 from merlin2_sailor.anchoring.identity_repair import Merge
 from merlin2_sailor.anchoring.matcher import Matcher
 
@@ -105,7 +104,7 @@ def decide_same_space(
             if anchor.symbol in settled or other.symbol in settled or not _may_be_one(anchor, other, colour):
                 continue
             overlap = shared_volume(anchor, other)
-            if overlap < minimum_overlap or not looks_alike(anchor, other, matcher, match_threshold, colour):
+            if overlap < minimum_overlap or not _looks_alike(anchor, other, matcher, match_threshold):
                 continue
             settled.update((anchor.symbol, other.symbol))
             if other.first_seen < anchor.first_seen:
@@ -166,21 +165,10 @@ def _stood_with(seen: Anchor, missing: Anchor) -> bool:
     )
 
 
-def looks_alike(first: Anchor, second: Anchor, matcher: Matcher | None, threshold: float,
-                colour: ColourEvidenceConfig) -> bool:
-    """Whether an appearance matcher takes the younger anchor for the older, place left out, by
-    what it saw of them (True for a matcher without appearance: it has no evidence to add).
-
-    Where it never compared their looks (:func:`~.anchor_comparison.looks_compared`: partial views,
-    no gallery) and their colours are not both known and agreeing, its score is the rules' (class,
-    size, time), which two objects of one class pass alike: no evidence that they are one. Two
-    bicycles 0.3 m apart, known only from end-on views through doorways, scored 1.00 so, and the
-    other bicycle's anchor was forgotten as a second anchor of the wheeled one's (and once the
-    wheeled one's as the other's): `bicycle_wheeled_beside_another`, network, seeds 0 and 1,
-    7 December 2026."""
+def _looks_alike(first: Anchor, second: Anchor, matcher: Matcher | None, threshold: float) -> bool:
+    """Whether an appearance matcher takes the younger anchor for the older, place left out
+    (True for a matcher without appearance: it has no evidence to add)."""
     if matcher is None or not matcher.uses_appearance:
         return True
     younger, older = (first, second) if first.first_seen >= second.first_seen else (second, first)
-    if not looks_compared(matcher, [younger], older)[0] and not colours_agree(younger.colour, older.colour, colour):
-        return False
     return score_anywhere(matcher, younger, older) >= threshold

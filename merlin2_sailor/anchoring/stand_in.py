@@ -26,8 +26,7 @@ these hold:
   objects' extents explains): where the object was, not across the room;
 - their colours do not differ, and a matcher that reads appearance takes it for the older one
   with place left out (:func:`~.anchor_comparison.score_anywhere`; a view off its place is
-  judged by its look, as a search judges a found object), by their looks compared or their colours
-  known and agreeing (:func:`~.same_space.looks_alike`: a score without either is the rules');
+  judged by its look, as a search judges a found object);
 - exactly one older anchor fits: two that were both away (look-alikes side by side) leave it
   undecided, and it stays.
 
@@ -46,7 +45,7 @@ from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
 from merlin2_sailor.anchoring.matcher import Matcher
-from merlin2_sailor.anchoring.same_space import Duplicate, looks_alike
+from merlin2_sailor.anchoring.same_space import Duplicate
 
 
 def decide_stand_ins(
@@ -72,9 +71,9 @@ def decide_stand_ins(
         if len(originals) != 1:
             continue
         original = originals[0]
-        if not looks_alike(stand_in, original, matcher, match_threshold, colour):
-            continue
         score = score_anywhere(matcher, stand_in, original) if matcher.uses_appearance else None
+        if score is not None and score < match_threshold:
+            continue
         distance = float(np.linalg.norm(stand_in.position[:2] - original.position[:2]))
         decisions.append(Duplicate(original, stand_in, 0.0,
                                    f"seen only while {original.symbol} was away, {distance:.2f} m from it", score))

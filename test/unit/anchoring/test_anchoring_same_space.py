@@ -244,21 +244,3 @@ def test_a_detector_drawing_one_box_across_two_books_for_a_while_leaves_two_anch
     assert [a.state for a in anchoring.anchors] == [AnchorState.CONFIRMED] * 2
     [gone] = [e for e in events if e.kind is AnchorEventKind.FORGOTTEN]
     assert gone.details["reason"].startswith("a box across")
-
-
-@pytest.mark.parametrize(("hue", "decided"), [(None, False), (RED, True)])
-def test_an_appearance_matcher_that_never_compared_their_looks_is_no_evidence(hue, decided):
-    """Neither anchor has a view whose look could be compared (too partial, or none kept): the
-    appearance matcher's score is then the rules', which any two of a class pass, and without
-    colours known to agree nothing says the two are one object (two bicycles 0.3 m apart, known
-    only end-on, one forgotten into the other: `bicycle_wheeled_beside_another`, network, seed 0)."""
-    from .anchoring_scenes import AppearanceRules
-
-    older_missing = book("book_3", 2.00, AnchorState.MISSING, 0.0, 50.0, hue=hue)
-    seen = book("book_8", 2.03, AnchorState.CONFIRMED, 40.0, 60.0, hue=hue)
-    index = AnchorIndex()
-    for anchor in (older_missing, seen):
-        index.add(anchor)
-    assert decide_same_space([seen], index, 0.5, COLOUR) != []  # the rules' judgement: one object
-    decisions = decide_same_space([seen], index, 0.5, COLOUR, AppearanceRules(), 0.5)
-    assert [(d.kept, d.merged) for d in decisions] == ([(older_missing, seen)] if decided else [])

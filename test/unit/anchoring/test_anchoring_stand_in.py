@@ -19,7 +19,6 @@ from merlin2_sailor.anchoring.anchor import Anchor
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel
 from merlin2_sailor.anchoring.features import PairFeatures
-from merlin2_sailor.anchoring.gallery import to_bfloat16_bits
 from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
@@ -190,28 +189,3 @@ def test_an_anchor_whose_sightings_then_are_forgotten_tells_nothing():
 def test_the_distance_is_checked():
     with pytest.raises(ConfigurationError, match="stand_in_distance"):
         RepairConfig(stand_in_distance=-0.1)
-
-
-@pytest.mark.parametrize(("looks", "hue", "decided"), [
-    ("never compared", None, False),  # an appearance score from class, size and time alone: no evidence
-    ("never compared", RED, True),  # both colours known and agreeing: evidence enough
-    ("compared, alike", None, True),
-    ("compared, unlike", None, False),
-])
-def test_an_appearance_matcher_joins_a_stand_in_only_by_what_it_saw_of_their_looks(looks, hue, decided):
-    """Two bicycles 0.3 m apart, known only from end-on views, scored 1.00 for each other by class,
-    size and time (the network's fallback where looks cannot be compared), and the other bicycle's
-    anchor was forgotten as the wheeled one's stand-in (`bicycle_wheeled_beside_another`, network,
-    seed 1, 7 December 2026)."""
-    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY, hue=hue)
-    stand_in = cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8, hue=hue)
-    if looks != "never compared":
-        maker = PerceptMaker(seed=9)
-        own, other = maker.appearance("own"), maker.appearance("other")
-        original.gallery = to_bfloat16_bits(own.reshape(1, -1))
-        stand_in.gallery = to_bfloat16_bits((own if looks == "compared, alike" else other).reshape(1, -1))
-    index = AnchorIndex()
-    for anchor in (stand_in, original):
-        index.add(anchor)
-    decisions = decide_stand_ins([stand_in], [], index, 0.25, COLOUR, AppearanceRules(), 0.5)
-    assert [(d.kept, d.duplicate) for d in decisions] == ([(original, stand_in)] if decided else [])
