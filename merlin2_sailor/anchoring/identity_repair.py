@@ -380,9 +380,10 @@ class IdentityRepair:
         possible = [anchor for symbol in sought.look_pending
                     if (anchor := index.get(symbol)) is not None
                     and self._possible(anchor, sought, include_missing=True)]
-        scored = [(anchor, self._anywhere(anchor, sought)) for anchor in possible]
-        pending = [anchor for anchor, score in scored if score >= self.match_threshold]
-        scores = tuple(score for _, score in scored if score >= self.match_threshold)
+        taken = [(anchor, score) for anchor in possible
+                 if (score := self._anywhere(anchor, sought)) >= self.match_threshold]
+        pending = [anchor for anchor, _ in taken]
+        scores = tuple(score for _, score in taken)
         if not pending:
             return None
         if len(pending) == 1:
