@@ -165,6 +165,9 @@ class Anchor:
     recent_sightings: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT_SIGHTINGS))
     """The stamps of its latest sightings, oldest first: whether it was seen while a newcomer beside
     it was (:mod:`.stand_in`). Not persisted: it matters for seconds."""
+    recent_places: deque[tuple[float, float]] = field(default_factory=lambda: deque(maxlen=RECENT_SIGHTINGS))
+    """Where it stood on the floor (x, y) after each of ``recent_sightings``, in step with them: whether
+    it stood beside such a newcomer before the newcomer was seen, or came from elsewhere (:mod:`.stand_in`)."""
     provenance: Provenance = Provenance.PERCEIVED
     """PERCEIVED when ``position`` comes from the camera, EXPECTED when from an action's effect."""
     perceived_position: np.ndarray = field(default_factory=_zero_vector)
@@ -288,7 +291,7 @@ class Anchor:
             visible=True,
             perceived_position=position.copy(),
         )
-        anchor.recent_sightings.append(percept.stamp)
+        anchor.note_sighting(percept.stamp)
         if embedding is not None and not partial:
             anchor.gallery, anchor.gallery_scales = add_view(None, None, embedding, view_scale(percept),
                                                              config.gallery_size)
@@ -346,13 +349,19 @@ class Anchor:
         if percept.tracker_id:
             self.last_tracker_id = percept.tracker_id
         self.last_seen = max(self.last_seen, percept.stamp)
-        self.recent_sightings.append(percept.stamp)
+        self.note_sighting(percept.stamp)
         if moves or perceived:
             self.perceived_position = self.position.copy()
             self.provenance = Provenance.PERCEIVED
         self.visible = True
         self.missed_frames = 0
         self.missing_since = None
+
+    def note_sighting(self, stamp: float) -> None:
+        """Remember a sighting's stamp and where the anchor stands after it (``recent_sightings``,
+        ``recent_places``)."""
+        self.recent_sightings.append(stamp)
+        self.recent_places.append((float(self.position[0]), float(self.position[1])))
 
     def _widen_to(self, percept: Percept) -> None:
         """Widen a box joined from parts to take in a view of a part beyond it, while the box around

@@ -24,6 +24,14 @@ these hold:
   seen 0.19 m off became a second anchor while its own never went missing);
 - it stands within ``reach`` of the older one (horizontally, plus what the larger of the two
   objects' extents explains): where the object was, not across the room;
+- and so did the older one at its last sighting before the newcomer's first (each anchor remembers
+  where it stood after those sightings, :attr:`~.anchor.Anchor.recent_places`): a momentary pose
+  error shows an object off a place it keeps, while an older anchor that was away because its object
+  was carried, and came back beside the newcomer, had stood elsewhere when the newcomer was first
+  seen, so the newcomer is the object that was there already. Measured in
+  `bicycle_wheeled_beside_another` (network, seed 1, 7 December 2026): the living room's bicycle,
+  seen from the doorway 3 m from the hall's, was forgotten as the hall's bicycle's stand-in when the
+  hall's one was found wheeled in beside it 40 s later;
 - their colours do not differ, and a matcher that reads appearance takes it for the older one
   with place left out (:func:`~.anchor_comparison.score_anywhere`; a view off its place is
   judged by its look, as a search judges a found object);
@@ -44,6 +52,7 @@ from merlin2_sailor.anchoring.anchor import Anchor, AnchorState
 from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, anchor_colours_differ
+from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.matcher import Matcher
 from merlin2_sailor.anchoring.same_space import Duplicate
 
@@ -67,7 +76,8 @@ def decide_stand_ins(
         if stand_in.expectation is not None:
             continue
         originals = [older for older in _beside(stand_in, index, reach)
-                     if _was_away_all_its_life(older, stand_in) and not anchor_colours_differ(older, stand_in, colour)]
+                     if _was_away_all_its_life(older, stand_in) and _stood_beside_it_before(older, stand_in, reach)
+                     and not anchor_colours_differ(older, stand_in, colour)]
         if len(originals) != 1:
             continue
         original = originals[0]
@@ -91,6 +101,18 @@ def _was_away_all_its_life(older: Anchor, stand_in: Anchor) -> bool:
         return False  # its sightings then are no longer remembered: nothing says it was away
     during = (sightings >= stand_in.first_seen) & (sightings <= stand_in.last_seen)
     return not during.any() and bool((sightings > stand_in.last_seen).any())
+
+
+def _stood_beside_it_before(older: Anchor, stand_in: Anchor, reach: float) -> bool:
+    """Whether ``older`` stood within ``reach`` of the stand-in (on the floor, plus what the larger
+    extent explains, as :func:`_beside` measures) at its latest remembered sighting before the
+    stand-in's first; False when no such sighting is remembered with its place."""
+    latest_first = zip(reversed(older.recent_sightings), reversed(older.recent_places), strict=False)
+    place = next((place for stamp, place in latest_first if stamp < stand_in.first_seen), None)
+    if place is None:
+        return False
+    slack = float(max(extent_slack(np.asarray(older.size)), extent_slack(np.asarray(stand_in.size))))
+    return float(np.linalg.norm(np.asarray(place) - stand_in.position[:2])) - slack <= reach
 
 
 def _beside(anchor: Anchor, index: AnchorIndex, reach: float) -> list[Anchor]:

@@ -119,10 +119,17 @@ AWAY = (19.8, 19.9, 20.0, 21.0, 21.1)
 
 
 def cup(symbol: str, y: float, state: AnchorState, first_seen: float, last_seen: float,
-        sightings: tuple[float, ...] = (), hue: int | None = None) -> Anchor:
+        sightings: tuple[float, ...] = (), hue: int | None = None, stood_before: tuple[float, float] | None = None,
+        ) -> Anchor:
+    """A cup's anchor at (2, ``y``), its ``sightings`` remembered there, or those up to 20.0 (before
+    its stand-ins below are first seen) at ``stood_before``: carried since."""
     anchor = Anchor(symbol, "cup", np.array((2.0, y, 0.8)), np.array((0.1, 0.1, 0.12)), first_seen, last_seen,
                     state=state, perceived_position=np.array((2.0, y, 0.8)), times_seen=max(len(sightings), 1))
-    anchor.recent_sightings.extend(sightings)
+    for stamp in sightings:
+        if stood_before is not None and stamp <= 20.0:
+            anchor.position[:2] = stood_before
+        anchor.note_sighting(stamp)
+        anchor.position[:2] = (2.0, y)
     if hue is not None:
         anchor.colour = ColourModel.of(mug_colour(hue))
         for _ in range(4):
@@ -154,6 +161,20 @@ def test_a_newcomer_seen_while_the_older_was_there_is_another_object(first_seen,
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, first_seen, last_seen)], original) == []
 
 
+@pytest.mark.parametrize(("stood_before", "a_stand_in"), [
+    ((2.0, -2.0), False),  # carried 2 m while away, and found beside the newcomer: the newcomer stays
+    ((4.5, 3.0), False),  # from another room
+    ((2.0, 0.6), False),  # from the next shelf
+    ((2.05, 0.1), True),  # a few centimetres from where it is found again: it stayed, the newcomer was it
+])
+def test_a_newcomer_beside_where_the_older_came_back_to_but_not_where_it_stood_stays(stood_before, a_stand_in):
+    """The two were never seen at one time, but the older one was elsewhere when the newcomer was
+    first seen: it was carried to the newcomer's side, which is not one object seen off its place."""
+    original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY, stood_before=stood_before)
+    decisions = decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)], original)
+    assert [(d.kept.symbol, d.duplicate.symbol) for d in decisions] == ([("cup_1", "cup_2")] if a_stand_in else [])
+
+
 def test_one_that_could_be_either_of_two_anchors_away_is_left_undecided():
     left = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)
     right = cup("cup_3", 0.3, AnchorState.CONFIRMED, 0.0, 30.0, sightings=AWAY)
@@ -182,8 +203,9 @@ def test_an_anchor_whose_sightings_then_are_forgotten_tells_nothing():
     original = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=later)
     original.times_seen = 500
     assert decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)], original) == []
-    original.times_seen = 64  # all it ever saw: it was not seen then
-    assert len(decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)], original)) == 1
+    everything = cup("cup_1", 0.0, AnchorState.CONFIRMED, 0.0, 30.0, sightings=(0.0, *later[1:]))
+    assert everything.times_seen == 64  # all it ever saw: it was not seen then
+    assert len(decide([cup("cup_2", 0.17, AnchorState.MISSING, 20.1, 20.8)], everything)) == 1
 
 
 def test_the_distance_is_checked():
