@@ -71,6 +71,7 @@ from merlin2_sailor_demos.report import (
     write_report,
 )
 from merlin2_sailor_demos.report.annotated_frame import AnchorInView, annotate_frame
+from merlin2_sailor_demos.report.merges import MergeLog
 from merlin2_sailor_demos.report.naming import symbols_before_change
 from merlin2_sailor_demos.report.scorecard import CLAIMING_STATES
 from merlin2_sailor_demos.report.truth_timeline import TruthTimeline, refers_to
@@ -158,6 +159,7 @@ class MissionDemoNode(Node):
         self._timeline = TruthTimeline()
         self._ambiguous: list[dict[str, Any]] = []  # the anchoring layer's "cannot tell apart" events
         self._acquired_because: dict[str, str] = {}  # symbol -> its acquired event's nearest_anchor
+        self._merges = MergeLog()  # every anchor forgotten into another, judged against the truth
         self._awaited: set[str] = set()  # the world's events a route stop has waited for
         self._grounding = Grounding(GroundingConfig.from_yaml(grounding_file))
         self._store = open_knowledge_base("ros:///merlin2")
@@ -339,6 +341,7 @@ class MissionDemoNode(Node):
         with self._lock:
             refers = {record.symbol: refers_to(record, seen, self._timeline) for record, seen in claiming}
             ambiguous = list(self._ambiguous)
+            merges = self._merges.as_dicts()
         return {
             "world": self._world.source,
             "target": self._target,
@@ -352,6 +355,7 @@ class MissionDemoNode(Node):
             "fetch": {"ran": fetch is not None, "succeeded": bool(fetch and fetch.succeeded),
                       "reason": fetch.reason if fetch is not None else why},
             "ambiguous": ambiguous,
+            "merges": merges,
             "expect": self._mission.expect.as_dict(),
         }
 
@@ -402,6 +406,12 @@ class MissionDemoNode(Node):
                 nearest = next((item.value for item in event.details if item.key == "nearest_anchor"), "")
                 with self._lock:
                     self._acquired_because[event.symbol] = nearest
+            if event.kind == AnchorEvent.KIND_FORGOTTEN:
+                details = {item.key: item.value for item in event.details}
+                if details.get("into"):
+                    with self._lock:
+                        self._merges.note_forgotten(event.symbol, details["into"], _stamp(event),
+                                                    details.get("reason", ""), self._timeline)
             if event.kind == AnchorEvent.KIND_AMBIGUOUS:
                 with self._lock:
                     self._ambiguous.append({"symbol": event.symbol, "stamp": _stamp(event),
@@ -418,6 +428,8 @@ class MissionDemoNode(Node):
         with self._lock:
             self._anchors = records
             self._anchor_views = views
+            for record, seen, _ in views:
+                self._merges.note_view(record, seen)
 
     def _record_identities(self) -> None:
         try:

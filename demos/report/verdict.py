@@ -17,7 +17,9 @@ The verdict is right when every claim is true:
 - expected not found (removed): not reported found, the symbol given to no other object, and no
   ``object_at`` left for it;
 - every ``keep_symbols`` object ends under the symbol it had, every ``new_symbols`` object under
-  a symbol no object had before, every ``anchored_once`` object with exactly one anchor.
+  a symbol no object had before, every ``anchored_once`` object with exactly one anchor;
+- no anchor of one object was merged into another object's, in any scenario
+  (:mod:`.merges`: the ``merges`` the demo recorded, each judged when it was made).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from merlin2_sailor_demos.report.merges import MergeRecord
 from merlin2_sailor_demos.world.mission import Expectation, ExpectedOutcome
 
 #: How a failed find says the evidence cannot choose between candidates ("cup_3 cannot be told
@@ -81,6 +84,8 @@ class Claims:
     expect: Expectation = field(default_factory=Expectation)
     ambiguous: tuple[Mapping[str, Any], ...] = ()
     """The anchoring layer's ``ambiguous`` events (symbol, stamp, details), every symbol's."""
+    merges: tuple[MergeRecord, ...] = ()
+    """Every anchor forgotten into another, with the objects both referred to then (:mod:`.merges`)."""
 
     @classmethod
     def from_scorecard(cls, card: Mapping[str, Any]) -> Claims:
@@ -96,6 +101,7 @@ class Claims:
                 bool(fetch["ran"]), bool(fetch["succeeded"]), str(fetch.get("reason", "")),
                 Expectation.from_mapping(expect, "claims.expect"),
                 tuple(data.get("ambiguous") or ()),
+                tuple(MergeRecord.from_mapping(merge) for merge in data.get("merges") or ()),
             )
         except (KeyError, TypeError, AttributeError) as error:
             raise ValueError(f"the scorecard has no usable 'claims' section ({error!r}); was it written by "
@@ -132,6 +138,7 @@ def judge(card: Mapping[str, Any], expect: Expectation | None = None) -> Verdict
             problems.append(f"the knowledge base places the removed {target}: "
                             + ", ".join(f"object_at({symbol}, {place})" for place in places))
     problems += _judge_symbols(claims, expect)
+    problems += [merge.problem() for merge in claims.merges if merge.wrong]
     scorecard_switches = card.get("identity_switches") or {}
     return Verdict(
         outcome=f"{FOUND} as {symbol}" if outcome == FOUND else outcome,

@@ -26,7 +26,9 @@ class AnchorEventKind(Enum):
     MISSING = "missing"
     """Should have been visible (in the frustum, not occluded) but was not seen."""
     FORGOTTEN = "forgotten"
-    """Missing for too long, or forgotten on request: the anchor and its symbol are gone."""
+    """Missing for too long, or forgotten on request: the anchor and its symbol are gone. When it
+    was found to be another anchor's object (merged, a duplicate, a part joined), ``details["into"]``
+    names that anchor, so a listener can follow the symbol without parsing the reason."""
     RETRACTED = "retracted"
     """An expected location was contradicted by what the camera saw."""
     AMBIGUOUS = "ambiguous"

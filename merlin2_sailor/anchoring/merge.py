@@ -94,7 +94,8 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     changes.forgotten.append(part)
     if kept not in changes.reacquired:
         changes.reacquired.append(kept)
-    changes.event(AnchorEventKind.FORGOTTEN, part.symbol, reason=f"{decision.reason}: it is {kept.symbol}")
+    changes.event(AnchorEventKind.FORGOTTEN, part.symbol, reason=f"{decision.reason}: it is {kept.symbol}",
+                  into=kept.symbol)
     changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=decision.reason, merged=part.symbol,
                   was_missing=was_missing, at=position_text(kept.position))
 
@@ -137,7 +138,7 @@ def apply_decision(
         if decision.score is not None:
             evidence["score"] = round(decision.score, 3)
         changes.event(AnchorEventKind.FORGOTTEN, duplicate.symbol,
-                      reason=decision.explanation, **evidence)
+                      reason=decision.explanation, into=decision.kept.symbol, **evidence)
         return
     if isinstance(decision, Unconfirmed):
         # Nothing merged, nothing said yet: the search looks on (see identity_repair).
@@ -186,6 +187,6 @@ def apply_decision(
     changes.forgotten.append(merged)
     changes.reacquired.append(kept)
     changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"{decision.reason}: it is {kept.symbol}",
-                  score=round(decision.score, 3))
+                  into=kept.symbol, score=round(decision.score, 3))
     if not still_missing:
         changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=decision.reason, merged=merged.symbol)
