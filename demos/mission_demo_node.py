@@ -34,7 +34,7 @@ import time
 import traceback
 from collections import deque
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from dataclasses import replace as dataclass_replace
 from pathlib import Path
 from typing import Any
@@ -341,7 +341,7 @@ class MissionDemoNode(Node):
         with self._lock:
             refers = {record.symbol: refers_to(record, seen, self._timeline) for record, seen in claiming}
             ambiguous = list(self._ambiguous)
-            merges = self._merges.as_dicts()
+            merges = [asdict(merge) for merge in self._merges.judged(self._timeline)]
         return {
             "world": self._world.source,
             "target": self._target,
@@ -411,7 +411,7 @@ class MissionDemoNode(Node):
                 if details.get("into"):
                     with self._lock:
                         self._merges.note_forgotten(event.symbol, details["into"], _stamp(event),
-                                                    details.get("reason", ""), self._timeline)
+                                                    details.get("reason", ""))
             if event.kind == AnchorEvent.KIND_AMBIGUOUS:
                 with self._lock:
                     self._ambiguous.append({"symbol": event.symbol, "stamp": _stamp(event),

@@ -1,34 +1,37 @@
 """Was an anchor merged into another object's symbol? Every merge the anchoring layer made, judged.
 
 A scorecard that judges only the target's claim misses a neighbour's symbol forgotten into another
-object's: the other bicycle's anchor taken for the wheeled one's "stand-in" left the planner one
-bicycle short and no claim wrong (`bicycle_wheeled_beside_another`, network, seed 1, 7 December
-2026). So the demo notes every FORGOTTEN event that names the anchor it was taken for
-(``details["into"]``: merges, duplicates, parts joined) with the object each of the two anchors
-referred to just then, each by its own latest sighting in the ground truth of that moment
-(:func:`.truth_timeline.refers_to`): a merge of two anchors that referred to two different objects
-gave one object's symbol to the other. A merge where either referred to no object (an anchor placed
-more than the scorecard's association distance from anything of its class) is recorded, not judged.
-
-The kept anchor's view is the latest that arrived before the event; the anchoring node publishes a
-frame's events before its anchors, so that is the view from before the merge. Should the anchors
-come first, the kept anchor's view is the merged one's and the merge is judged right: a merge can be
-missed, never blamed wrongly.
+object's: the living room's bicycle, whose anchor a same-space merge and then a join of parts
+folded into the wheeled bicycle's, ended with no symbol at all, and the run counted right
+(`bicycle_wheeled_beside_another`, network, seed 2, 7 December 2026). So the demo notes every
+FORGOTTEN event that names the anchor it was taken for (``details["into"]``: merges, duplicates,
+parts joined) and judges it by the object each of the two anchors was first the anchor of: the
+nearest object of its class, within :data:`~.truth_timeline.REFERS_DISTANCE` of the object's
+footprint, at the first sighting that had one, in the ground truth of that moment. Two different
+objects: one object's symbol went to the other. The *first* object, not the latest: an anchor that
+took another object's views before the merge refers to that one by then (the living room's
+bicycle's anchor did), and the first is also what the planner was first told the symbol means.
+The footprint, not the centre: a bicycle seen only end-on is anchored at its near end, 0.8 m from
+its centre. An anchor never near an object of its class is recorded, not judged.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
-from merlin2_sailor_demos.report.scorecard import AnchorRecord
-from merlin2_sailor_demos.report.truth_timeline import TruthTimeline, refers_to
+from merlin2_sailor_demos.report.scorecard import AnchorRecord, TrueObject
+from merlin2_sailor_demos.report.truth_timeline import REFERS_DISTANCE, TruthTimeline
+
+#: Sightings of each anchor kept to find the first object it was the anchor of: a few seconds' worth.
+FIRST_VIEWS = 64
 
 
 @dataclass(frozen=True)
 class MergeRecord:
-    """One anchor forgotten ``into`` another, and the objects each referred to then (None: none)."""
+    """One anchor forgotten ``into`` another, and the objects each was first the anchor of (None: none)."""
 
     stamp: float
     forgotten: str
@@ -43,8 +46,8 @@ class MergeRecord:
                 and self.forgotten_refers != self.into_refers)
 
     def problem(self) -> str:
-        return (f"{self.forgotten} (the {self.forgotten_refers}) was merged into {self.into} (the "
-                f"{self.into_refers})" + (f": {self.reason}" if self.reason else ""))
+        return (f"{self.forgotten} (the {self.forgotten_refers}'s) was merged into {self.into} (the "
+                f"{self.into_refers}'s)" + (f": {self.reason}" if self.reason else ""))
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any]) -> MergeRecord:
@@ -53,24 +56,52 @@ class MergeRecord:
 
 
 class MergeLog:
-    """The latest view of every anchor, and the merges judged from them as their events arrive."""
+    """Each anchor's first sightings and the merges, judged at the end (:meth:`judged`) against the
+    whole ground-truth timeline: read once a second, it may lag a change a view already shows."""
 
-    def __init__(self) -> None:
-        self._views: dict[str, tuple[AnchorRecord, float]] = {}
-        self.merges: list[MergeRecord] = []
+    def __init__(self, first_views: int = FIRST_VIEWS) -> None:
+        self._first_views = first_views
+        self._views: dict[str, list[tuple[AnchorRecord, float]]] = {}
+        self._forgotten: list[tuple[float, str, str, str]] = []
 
     def note_view(self, record: AnchorRecord, seen: float) -> None:
-        """An anchor as the latest anchors message showed it, last seen at ``seen``."""
-        self._views[record.symbol] = (record, seen)
+        """An anchor as an anchors message showed it, last seen at ``seen``."""
+        views = self._views.setdefault(record.symbol, [])
+        if len(views) < self._first_views and (not views or views[-1][1] != seen):
+            views.append((record, seen))
 
-    def note_forgotten(self, symbol: str, into: str, stamp: float, reason: str, timeline: TruthTimeline) -> None:
+    def note_forgotten(self, symbol: str, into: str, stamp: float, reason: str) -> None:
         """``symbol`` was forgotten as ``into``'s object at ``stamp``."""
-        self.merges.append(MergeRecord(stamp, symbol, into, self._refers(symbol, timeline),
-                                       self._refers(into, timeline), reason))
+        self._forgotten.append((stamp, symbol, into, reason))
 
-    def as_dicts(self) -> list[dict[str, Any]]:
-        return [asdict(merge) for merge in self.merges]
+    def judged(self, timeline: TruthTimeline) -> list[MergeRecord]:
+        """Every merge, with the object each of its two anchors was first the anchor of."""
+        return [MergeRecord(stamp, symbol, into, self._first_object(symbol, timeline),
+                            self._first_object(into, timeline), reason)
+                for stamp, symbol, into, reason in self._forgotten]
 
-    def _refers(self, symbol: str, timeline: TruthTimeline) -> str | None:
-        view = self._views.get(symbol)
-        return refers_to(view[0], view[1], timeline) if view is not None else None
+    def _first_object(self, symbol: str, timeline: TruthTimeline) -> str | None:
+        seen = (object_seen(record, timeline.at(stamp)) for record, stamp in self._views.get(symbol, ()))
+        return next((found for found in seen if found is not None), None)
+
+
+def object_seen(anchor: AnchorRecord, truth: Sequence[TrueObject], max_distance: float = REFERS_DISTANCE) -> str | None:
+    """The id of the object of ``anchor``'s class whose footprint (its centre without a size) is
+    nearest the anchor on the floor, within ``max_distance``; the nearer centre breaks a tie."""
+    best: tuple[float, float, str] | None = None
+    for obj in truth:
+        if obj.class_name != anchor.class_name:
+            continue
+        centre = math.dist(obj.position[:2], anchor.position[:2])
+        gap = _footprint_gap(anchor.position, obj)
+        if gap <= max_distance and (best is None or (gap, centre) < best[:2]):
+            best = (gap, centre, obj.id)
+    return best[2] if best is not None else None
+
+
+def _footprint_gap(point: Sequence[float], obj: TrueObject) -> float:
+    """How far ``point`` lies from ``obj``'s upright, axis-aligned footprint on the floor (0 inside)."""
+    half = (0.0, 0.0) if obj.size is None else (obj.size[0] / 2.0, obj.size[1] / 2.0)
+    dx = max(abs(point[0] - obj.position[0]) - half[0], 0.0)
+    dy = max(abs(point[1] - obj.position[1]) - half[1], 0.0)
+    return math.hypot(dx, dy)

@@ -27,6 +27,8 @@ class TrueObject:
     id: str
     class_name: str
     position: tuple[float, float, float]
+    size: tuple[float, float, float] | None = None
+    """Its box's extent along the world's axes (None: not known)."""
 
 
 @dataclass(frozen=True)

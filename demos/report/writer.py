@@ -67,7 +67,8 @@ def explain_duplicates(duplicates: Sequence[str], anchors: Sequence[AnchorRecord
 def truth_from_ground_truth(data: dict[str, Any]) -> list[TrueObject]:
     """True objects from the world node's ground_truth.json (carried objects left out)."""
     return [
-        TrueObject(obj["id"], obj["class"], tuple(obj["position"]))
+        TrueObject(obj["id"], obj["class"], tuple(obj["position"]),
+                   tuple(obj["size"]) if obj.get("size") is not None else None)
         for obj in data.get("objects", [])
         if not obj.get("carried")
     ]
