@@ -336,8 +336,9 @@ class IdentityRepair:
         (``sought.found_by_look_alone``) for the MISSING ``sought``: a :class:`Merge`, unless a copy
         of it is anchored by now or another anchor may as well be it (:meth:`_also_possible`), then
         :class:`Undecided`, or the candidate is gone or no longer possible (None: nothing to take).
-        Without a candidate, what the search met without seeing its look (:meth:`_still_pending`),
-        else an :class:`Undecided` when the search left anchors in question, or an
+        Without a candidate, or with one its views since rule out (the matching function no longer
+        takes it for the sought one, place left out), what the search met without seeing its look
+        (:meth:`_still_pending`), else an :class:`Undecided` when the search left anchors in question, or an
         :class:`Unconfirmed` (a candidate to conclude on) when it left one alone and no copy
         (:meth:`_left_in_question`)."""
         if sought.state is not AnchorState.MISSING or sought.indistinguishable_from:
@@ -356,6 +357,13 @@ class IdentityRepair:
                 or anchor_colours_differ(found, sought, self.colour) or self._seen_elsewhere(sought, found)):
             return None
         score = self._anywhere(found, sought)
+        if score < self.match_threshold:
+            # Taken for it when found, ruled out by its views since: no longer a candidate, so the
+            # search concludes as one that found none would. Measured: the living room's bicycle,
+            # found by look alone while seen end-on, scored 0.13 once more of it was seen, and was
+            # merged into the wheeled bicycle's symbol at the conclusion all the same
+            # (`bicycle_wheeled_beside_another`, network, seed 4, 7 December 2026).
+            return self._still_pending(sought, index) or self._left_in_question(sought, index)
         twins = self._twins(sought, index, besides=found)
         if twins:
             return Undecided((sought,), (found, *twins), (score,),

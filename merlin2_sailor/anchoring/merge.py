@@ -20,7 +20,7 @@ from merlin2_sailor.anchoring.identity_repair import Decision, LookPending, Merg
 from merlin2_sailor.anchoring.observation import drop_expectation
 from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS
 from merlin2_sailor.anchoring.parts import Parts, is_part, reaches_past
-from merlin2_sailor.anchoring.percept_checks import position_text
+from merlin2_sailor.anchoring.percept_checks import box_text, position_text
 from merlin2_sailor.anchoring.place_return import Return, trade_places
 from merlin2_sailor.anchoring.same_space import Duplicate
 
@@ -65,6 +65,7 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     within that, and it is never the extent that joins are judged by, so joins cannot widen the
     class's known extent step by step."""
     kept, part = decision.kept, decision.part
+    boxes = _boxes(kept, part)
     whole = next((anchor for anchor in (kept, part) if not is_part(anchor, decision.known)), None)
     for anchor in (kept, part):
         if anchor is not whole:  # its views are of parts, not of the object (see parts)
@@ -95,9 +96,14 @@ def join_parts(decision: Parts, index: AnchorIndex, changes: FrameChanges, fusio
     if kept not in changes.reacquired:
         changes.reacquired.append(kept)
     changes.event(AnchorEventKind.FORGOTTEN, part.symbol, reason=f"{decision.reason}: it is {kept.symbol}",
-                  into=kept.symbol)
+                  into=kept.symbol, **boxes)
     changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=decision.reason, merged=part.symbol,
                   was_missing=was_missing, at=position_text(kept.position))
+
+
+def _boxes(kept: Anchor, forgotten: Anchor) -> dict[str, str]:
+    """The two anchors' boxes before a merge, for the FORGOTTEN event: what the evidence looked like."""
+    return {"box": box_text(forgotten.position, forgotten.size), "into_box": box_text(kept.position, kept.size)}
 
 
 def _hand_over_sightings(kept: Anchor, merged: Anchor, index: AnchorIndex) -> None:
@@ -138,7 +144,8 @@ def apply_decision(
         if decision.score is not None:
             evidence["score"] = round(decision.score, 3)
         changes.event(AnchorEventKind.FORGOTTEN, duplicate.symbol,
-                      reason=decision.explanation, into=decision.kept.symbol, **evidence)
+                      reason=decision.explanation, into=decision.kept.symbol, **evidence,
+                      **_boxes(decision.kept, duplicate))
         return
     if isinstance(decision, Unconfirmed):
         # Nothing merged, nothing said yet: the search looks on (see identity_repair).
@@ -162,6 +169,7 @@ def apply_decision(
                           scores=",".join(f"{score:.2f}" for score in decision.scores))
         return
     kept, merged = decision.kept, decision.merged
+    boxes = _boxes(kept, merged)
     still_missing = merged.state is AnchorState.MISSING
     was_visible = merged.visible
     kept.absorb_anchor(merged, fusion, decision.moved)
@@ -187,6 +195,6 @@ def apply_decision(
     changes.forgotten.append(merged)
     changes.reacquired.append(kept)
     changes.event(AnchorEventKind.FORGOTTEN, merged.symbol, reason=f"{decision.reason}: it is {kept.symbol}",
-                  into=kept.symbol, score=round(decision.score, 3))
+                  into=kept.symbol, score=round(decision.score, 3), **boxes)
     if not still_missing:
         changes.event(AnchorEventKind.CONFIRMED, kept.symbol, reason=decision.reason, merged=merged.symbol)

@@ -56,3 +56,10 @@ def point(values: Any, name: str) -> np.ndarray:
 def position_text(position: np.ndarray) -> str:
     """A position as people read it in a log line: where an object was first seen says much about why."""
     return "(" + ", ".join(f"{float(value):.2f}" for value in position) + ")"
+
+
+def box_text(position: np.ndarray, size: np.ndarray) -> str:
+    """A box as people read it in a log line: "0.35 x 1.60 x 1.00 m at (2.57, 5.80, 0.49)". Why two
+    anchors were taken for one object is mostly in their boxes, which the snapshot keeps only for
+    the one that stays."""
+    return " x ".join(f"{float(value):.2f}" for value in size) + f" m at {position_text(position)}"
