@@ -97,6 +97,36 @@ def test_an_anchor_of_another_colour_in_a_lost_ones_place_is_another_object():
                       book("book_2", 2.01, AnchorState.CONFIRMED, 40.0, 60.0, hue=RED))) == 1
 
 
+def box(symbol: str, class_name: str, centre: tuple[float, float], size: tuple[float, float, float],
+        state: AnchorState, first_seen: float, last_seen: float) -> Anchor:
+    anchor = book(symbol, centre[0], state, first_seen, last_seen)
+    anchor.class_name, anchor.size = class_name, np.array(size)
+    anchor.position[:2] = anchor.perceived_position[:2] = centre
+    return anchor
+
+
+@pytest.mark.parametrize(("class_name", "across", "held", "size"), [
+    # a box across two bicycles side by side 0.65 m apart, seen end-on; the other's end inside it
+    ("bicycle", (2.9, 5.85), (3.24, 6.0), (0.35, 0.3, 1.0)),
+    # across two books of a shelf; the right one's anchor inside it, near its edge
+    ("book", (2.0, 2.0), (2.09, 2.0), (0.16, 0.04, 0.24)),
+    # across a row of three mugs; the middle one's anchor beside its centre, the first one's
+    ("cup", (1.0, 0.0), (0.92, 0.02), (0.09, 0.09, 0.11)),
+])
+def test_a_small_anchor_inside_a_box_drawn_across_two_objects_is_not_one_space_with_it(
+    class_name, across, held, size,
+):
+    """The smaller box shares all its volume with the larger, but neither's centre lies in the
+    other's footprint: a box across two objects holds one of them, it is not the same space."""
+    wide = (float(size[0]) * 3.0, float(size[1]) * 2.0, float(size[2]))
+    seen_across = box(f"{class_name}_1", class_name, across, wide, AnchorState.CONFIRMED, 0.0, 60.0)
+    missing = box(f"{class_name}_2", class_name, held, size, AnchorState.MISSING, 10.0, 50.0)
+    assert shared_volume(seen_across, missing) > 0.7
+    assert decide(seen_across, missing) == []
+    missing.position[:2] = across  # the same box on the wide one's centre: one space
+    assert len(decide(seen_across, missing)) == 1
+
+
 def test_a_pair_that_never_stood_together_is_left_to_the_reappearance_rules():
     """Born after the missing one's last sighting: perhaps another book put in its place."""
     assert decide(book("book_1", 2.00, AnchorState.MISSING, 0.0, 30.0),
