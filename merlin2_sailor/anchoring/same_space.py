@@ -13,10 +13,11 @@ anchor left in `crowded_shelf` (both matchers) and three of the five in `removed
 such pairs (overlap 0.6-1.0).
 
 The centres, not only the overlap: a small box wholly inside a large one shares all of the
-smaller's volume without the two being one space. A detector's box drawn across two bicycles
-standing side by side, fused into one bicycle's anchor, held the end of the other one's, and the
-other bicycle's anchor was forgotten into it, twice in five seeds of
-`bicycle_wheeled_beside_another` (network, 7 December 2026; overlap 0.74 and 0.79).
+smaller's volume without the two being one space. In five seeds of `bicycle_wheeled_beside_another`
+(network, 7 December 2026) the wheeled bicycle's anchor, on its near end, was twice forgotten into
+the anchor of the bicycle it stood 0.65 m beside (overlap 0.74 and 0.79, centres 0.67-0.7 m apart
+across the bicycles' 0.35 m width): that anchor's box must have been about a metre wide, one
+drawn across both bicycles seen end-on (the log then kept no boxes; merges now report both).
 
 No merge without evidence: with a matcher that reads appearance, the matching function must also
 take the younger anchor, its place left out (both stand on one spot by construction), for the
