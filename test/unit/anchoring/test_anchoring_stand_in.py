@@ -88,6 +88,10 @@ def test_a_pose_glitch_leaves_each_object_one_anchor_under_its_first_symbol(shif
     stand_ins = [e for e in events if e.kind is AnchorEventKind.FORGOTTEN and "was away" in e.details["reason"]]
     assert len(stand_ins) == len(shifts), [e.details for e in events if e.kind is AnchorEventKind.FORGOTTEN]
     assert all(e.details["score"] >= 0.5 for e in stand_ins)
+    # Each names the anchor it was taken for (the symbol it had first), and both boxes as they were.
+    classes = {item.identity: item.class_name for item in SCENE}
+    assert sorted(e.details["into"] for e in stand_ins) == sorted(f"{classes[name]}_1" for name in shifts)
+    assert all(e.details["box"].endswith(")") and " m at (" in e.details["into_box"] for e in stand_ins)
     # Without either rule each shifted object keeps a second, MISSING anchor.
     anchors, _ = run(shifts, glitch, stand_in_distance=0.0, reappearance_distance=0.0)
     assert sum(a.state is AnchorState.MISSING for a in anchors) == len(shifts)
