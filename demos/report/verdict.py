@@ -19,7 +19,8 @@ The verdict is right when every claim is true:
 - every ``keep_symbols`` object ends under the symbol it had, every ``new_symbols`` object under
   a symbol no object had before, every ``anchored_once`` object with exactly one anchor;
 - no anchor of one object was merged into another object's, in any scenario
-  (:mod:`.merges`: the ``merges`` the demo recorded, each judged when it was made).
+  (:mod:`.merges`: the ``merges`` the demo recorded, each with the objects its two anchors were
+  first the anchors of).
 """
 
 from __future__ import annotations
@@ -85,7 +86,7 @@ class Claims:
     ambiguous: tuple[Mapping[str, Any], ...] = ()
     """The anchoring layer's ``ambiguous`` events (symbol, stamp, details), every symbol's."""
     merges: tuple[MergeRecord, ...] = ()
-    """Every anchor forgotten into another, with the objects both referred to then (:mod:`.merges`)."""
+    """Every anchor forgotten into another, with the objects the two were first the anchors of (:mod:`.merges`)."""
 
     @classmethod
     def from_scorecard(cls, card: Mapping[str, Any]) -> Claims:
