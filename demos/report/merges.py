@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from merlin2_sailor_demos.report.scorecard import AnchorRecord, TrueObject
-from merlin2_sailor_demos.report.truth_timeline import REFERS_DISTANCE, TruthTimeline
+from merlin2_sailor_demos.report.truth_timeline import REFERS_DISTANCE, TruthTimeline, nearest_of_class
 
 #: Sightings of each anchor kept to find the first object it was the anchor of: a few seconds' worth.
 FIRST_VIEWS = 64
@@ -88,15 +88,10 @@ class MergeLog:
 def object_seen(anchor: AnchorRecord, truth: Sequence[TrueObject], max_distance: float = REFERS_DISTANCE) -> str | None:
     """The id of the object of ``anchor``'s class whose footprint (its centre without a size) is
     nearest the anchor on the floor, within ``max_distance``; the nearer centre breaks a tie."""
-    best: tuple[float, float, str] | None = None
-    for obj in truth:
-        if obj.class_name != anchor.class_name:
-            continue
-        centre = math.dist(obj.position[:2], anchor.position[:2])
-        gap = _footprint_gap(anchor.position, obj)
-        if gap <= max_distance and (best is None or (gap, centre) < best[:2]):
-            best = (gap, centre, obj.id)
-    return best[2] if best is not None else None
+    def measure(obj: TrueObject) -> tuple[float, float]:
+        return _footprint_gap(anchor.position, obj), math.dist(obj.position[:2], anchor.position[:2])
+
+    return nearest_of_class(anchor, truth, measure, max_distance)
 
 
 def _footprint_gap(point: Sequence[float], obj: TrueObject) -> float:

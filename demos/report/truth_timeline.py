@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from merlin2_sailor_demos.report.scorecard import AnchorRecord, TrueObject
@@ -45,13 +45,21 @@ class TruthTimeline:
 
 
 def refers_to(anchor: AnchorRecord, last_seen: float, timeline: TruthTimeline,
-              max_distance: float = REFERS_DISTANCE) -> str | None:
+               max_distance: float = REFERS_DISTANCE) -> str | None:
     """The id of the object ``anchor`` refers to (nearest of its class at its last sighting), or None."""
-    best, best_distance = None, max_distance
-    for obj in timeline.at(last_seen):
+    return nearest_of_class(anchor, timeline.at(last_seen), lambda obj: (math.dist(obj.position, anchor.position),),
+                            max_distance)
+
+
+def nearest_of_class(anchor: AnchorRecord, truth: Sequence[TrueObject],
+                     measure: Callable[[TrueObject], tuple[float, ...]], max_distance: float) -> str | None:
+    """The id of the object of ``anchor``'s class with the least ``measure`` (a distance first, then
+    what breaks its ties) whose distance is within ``max_distance``; the later of equals; None: none."""
+    best, best_measure = None, (max_distance, math.inf)
+    for obj in truth:
         if obj.class_name != anchor.class_name:
             continue
-        distance = math.dist(obj.position, anchor.position)
-        if distance <= best_distance:
-            best, best_distance = obj.id, distance
+        measured = measure(obj)
+        if measured[0] <= max_distance and measured <= best_measure:
+            best, best_measure = obj.id, measured
     return best
