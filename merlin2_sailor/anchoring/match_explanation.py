@@ -31,15 +31,18 @@ def best_candidate(table: MatchingTable, row: int, excluded: int | None = None) 
 def matched_over(table: MatchingTable, row: int, column: int) -> str:
     """``"0.83 over cup_4 (confirmed, 0.31 m) 0.79"``: the pair's score, then the best other
     anchor of the view's class that passed the gate for it (its state, how far the view stands
-    from it, its score), or ``"0.83, no other candidate"``."""
-    score = f"{table.scores[row, column]:.2f}"
+    from it, its score), or ``"0.83, no other candidate"``. A score that did not read the view's
+    look (the matcher's fallback: class, place and time) is marked ``by place``: two bicycles' anchors
+    scored 0.89 and 0.27 for one view by how long each had been unseen, and which object the view
+    showed could not be read from the line."""
+    score = f"{table.scores[row, column]:.2f}{_by_place(table, row, column)}"
     best = best_candidate(table, row, excluded=column)
     if best is None:
         said = f"{score}, no other candidate"
     else:
         anchor = table.anchors[best]
         said = (f"{score} over {anchor.symbol} ({anchor.state.value}, {_distance(table, row, best):.2f} m) "
-                f"{table.scores[row, best]:.2f}")
+                f"{table.scores[row, best]:.2f}{_by_place(table, row, best)}")
     kept = kept_from(table, row, column)
     return f"{said}; nearer, kept from it: {kept}" if kept else said
 
@@ -74,6 +77,12 @@ def _why_gated(table: MatchingTable, row: int, column: int) -> str:
     if table.shortcut[row]:
         return "the view continues another anchor's tracker id"
     return "out of reach"
+
+
+def _by_place(table: MatchingTable, row: int, column: int) -> str:
+    if table.by_look is None or table.by_look[row, column]:
+        return ""
+    return " by place"
 
 
 def _distance(table: MatchingTable, row: int, column: int) -> float:

@@ -170,6 +170,10 @@ class MatchingTable:
     colour_gaps: Mapping[tuple[int, int], str] = dataclasses.field(default_factory=dict)
     """{(row, column): how the view's colour differed} for the pairs held apart or ruled out by a
     view of another colour (:func:`~.colour_evidence.view_gap_text`), for the log."""
+    by_look: np.ndarray | None = None
+    """(P, A) bool: the scored pairs whose score read the view's look against the anchor's (None: the
+    matcher reads no look); elsewhere a score is the matcher's fallback (class, place and time), which
+    the log says, since it is no evidence of which of two objects of a class a view shows."""
 
 
 class MatchingTableBuilder:
@@ -232,7 +236,7 @@ class MatchingTableBuilder:
         continuations &= ~gated
 
         to_score = ~gated & ~shortcut[:, np.newaxis]
-        comparable, embedded = None, 0
+        comparable, embedded, by_look = None, 0, None
         if self.matcher.uses_appearance:  # only a matcher that reads the look needs to know which views show it
             comparable = comparable_views(columns.sizes, whole, anchors)
             percepts, embedded = self._embed_needed(percepts, np.flatnonzero((to_score & comparable).any(axis=1)))
@@ -248,6 +252,8 @@ class MatchingTableBuilder:
             if comparable is not None:
                 features = dataclasses.replace(
                     features, appearance_known=features.appearance_known & comparable[rows, score_columns])
+                by_look = np.zeros(shape, dtype=bool)
+                by_look[rows, score_columns] = features.appearance_known
             scores[rows, score_columns] = self.matcher.score_pairs(features)
         if anchor_columns.search_radii is not None:
             searched = (anchor_columns.search_radii > 0.0)[np.newaxis, :] & to_score
@@ -281,7 +287,7 @@ class MatchingTableBuilder:
                 continuations &= ~searched_apart
                 ruled_out |= searched_apart
         return MatchingTable(percepts, anchors, scores, gated, continuations, shortcut, embedded, disputed, ruled_out,
-                             suspected, held, colour_gaps)
+                             suspected, held, colour_gaps, by_look)
 
     def _ungated_pairs(self, percepts: PerceptColumns, index: AnchorIndex) -> tuple[np.ndarray, np.ndarray]:
         """(rows, slots) of the pairs that pass the gate, computed on the index's arrays only.

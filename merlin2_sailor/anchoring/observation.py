@@ -17,7 +17,7 @@ from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting, before_sighting, sighting_brings_back
 from merlin2_sailor.anchoring.partial_view import centre_beyond_near_face, smaller_than_known
-from merlin2_sailor.anchoring.percept_checks import position_text
+from merlin2_sailor.anchoring.percept_checks import box_text, position_text
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
 
@@ -53,6 +53,9 @@ def reacquire(
         resolve_expectation(anchor, percept, changes, expectation_tolerance)
     was_missing = anchor.state is AnchorState.MISSING
     missing_since = anchor.missing_since
+    # Why a view went to this anchor is read from both boxes (a part's box is centred off its object).
+    boxes = {"view": box_text(percept.position, percept.size),
+             "anchor_box": box_text(anchor.position, anchor.size)} if scored else {}
     # Less of the object than its whole views showed: seen from its end, its near face, the rest
     # beyond it along the line of sight. Whole by the camera's tests, such a view is partial all
     # the same; cut by them (a door frame, the image's edge), it is a near face too where it is
@@ -80,7 +83,7 @@ def reacquire(
     changes.reacquired.append(anchor)
     changes.event(
         AnchorEventKind.REACQUIRED, anchor.symbol, was_missing=was_missing, tracker_id=percept.tracker_id,
-        tracker_continued=continued, **({"scored": scored} if scored else {}),
+        tracker_continued=continued, **({"scored": scored} if scored else {}), **boxes,
     )
     if became_confirmed:
         changes.event(AnchorEventKind.CONFIRMED, anchor.symbol, reason="seen", times_seen=anchor.times_seen)
