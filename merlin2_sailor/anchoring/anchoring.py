@@ -59,9 +59,10 @@ from merlin2_sailor.anchoring.matching_table import (
     with_embeddings,
 )
 from merlin2_sailor.anchoring.merge import apply_decision, join_parts, withdraw_stale_ambiguities
+from merlin2_sailor.anchoring.object_centre import placed_on_objects
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
-from merlin2_sailor.anchoring.parts import decide_parts, note_seen_together
+from merlin2_sailor.anchoring.parts import decide_parts, largest_seen_whole, note_seen_together
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
 from merlin2_sailor.anchoring.place_return import Return, decide_returns, note_jump
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
@@ -231,6 +232,9 @@ class Anchoring:
                                                                               self.config.partial_view)
         # Unless something says which views are whole, no single view is colour evidence.
         whole = None if camera is None and not told else [not flag for flag in partial]
+        # A large object's view is centred on the face the camera saw; its object's middle lies beyond
+        # (:mod:`.object_centre`). After the partial-view tests, which measure the face itself.
+        percepts = placed_on_objects(percepts, self._known_extent)
         # The pose error all of this frame's percepts share is taken out before anything is judged;
         # views of a row that sits off its anchors by an error read two ways are held out.
         reading = read_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
@@ -438,6 +442,10 @@ class Anchoring:
             self._own_counter.note_used(anchor.symbol for anchor in anchors)
 
     # --- internals --------------------------------------------------------------------------
+
+    def _known_extent(self, class_name: str) -> np.ndarray | None:
+        """The extent of the largest whole one of the class seen (None: none, or a small class)."""
+        return largest_seen_whole(self._index, class_name, self.config.repair.part_slack)
 
     def _fresh_symbol(self, class_name: str) -> str:
         symbol = self._new_symbol(class_name)

@@ -16,7 +16,7 @@ from merlin2_sailor.anchoring.expectation import ExpectationKind
 from merlin2_sailor.anchoring.frame_changes import FrameChanges
 from merlin2_sailor.anchoring.fusion import FusionConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig, after_sighting, before_sighting, sighting_brings_back
-from merlin2_sailor.anchoring.partial_view import centre_beyond_near_face, smaller_than_known
+from merlin2_sailor.anchoring.partial_view import smaller_than_known
 from merlin2_sailor.anchoring.percept_checks import box_text, position_text
 from merlin2_sailor.contract.percept import Percept
 from merlin2_sailor.knowledge.model import Provenance
@@ -78,8 +78,7 @@ def reacquire(
         anchor.indistinguishable_from = ()  # seen as itself: its identity is decided again
         anchor.look_pending = ()
         if searching:
-            resolve_expectation(anchor, percept, changes, expectation_tolerance,
-                                centre_beyond_near_face(percept, anchor.size) if shows_less else None)
+            resolve_expectation(anchor, percept, changes, expectation_tolerance)
     changes.reacquired.append(anchor)
     changes.event(
         AnchorEventKind.REACQUIRED, anchor.symbol, was_missing=was_missing, tracker_id=percept.tracker_id,
@@ -93,11 +92,10 @@ def reacquire(
             changes.returned.append(anchor)
 
 
-def resolve_expectation(anchor: Anchor, percept: Percept, changes: FrameChanges, tolerance: float,
-                        seen_centre: np.ndarray | None = None) -> None:
+def resolve_expectation(anchor: Anchor, percept: Percept, changes: FrameChanges, tolerance: float) -> None:
     """Perception outranks expectation: seen near the expected place confirms, elsewhere retracts.
-    ``seen_centre``: where the view puts the object's centre, where that is not the view's own
-    (a large object's near face: :func:`~.partial_view.centre_beyond_near_face`)."""
+    A large object's view is centred on the object already, not on its near face
+    (:mod:`.object_centre`)."""
     expectation = anchor.expectation
     assert expectation is not None
     distance = float(np.linalg.norm(np.asarray(percept.position) - anchor.position))
@@ -114,8 +112,7 @@ def resolve_expectation(anchor: Anchor, percept: Percept, changes: FrameChanges,
         # views (a bicycle seen through a door frame) do not move it from. Left there, the bicycle
         # found from the kitchen was placed 2.1 m off, in the kitchen (scenario suite,
         # `large_object_wheeled_away`, network, 6 December 2026).
-        centre = percept.position if seen_centre is None else seen_centre
-        anchor.position = np.asarray(centre, dtype=np.float64).copy()
+        anchor.position = np.asarray(percept.position, dtype=np.float64).copy()
         anchor.perceived_position = anchor.position.copy()
     if expectation.kind is ExpectationKind.CARRIED:
         anchor.expectation_confirmed = True  # still carried: keep following the robot

@@ -90,33 +90,6 @@ def smaller_than_known(percept: Percept, anchor: Anchor) -> bool:
     return bool(_shows_less(np.asarray(percept.size, dtype=np.float64).reshape(1, 3), [anchor])[0, 0])
 
 
-def centre_beyond_near_face(percept: Percept, known_size: np.ndarray) -> np.ndarray:
-    """Where a large object's centre lies, seen shorter than its known extent along the line of
-    sight: the camera measured the face nearest it, and the rest of the object lies beyond, away
-    from the viewpoint. Boxes are upright and aligned with the world's axes, so the rest lies along
-    the horizontal axis nearest the line of sight: the centre is the view's, moved along that axis,
-    away from the viewpoint, by half the view's shortfall on it. Unchanged without a viewpoint or a
-    shortfall (a view across an object is as deep as the object). Whether the camera's tests saw
-    the view cut does not matter: a door frame or the image's edge cuts a view's width, not its
-    depth.
-
-    Measured: a bicycle 1.6 m long wheeled into the living room, seen from there only end-on, was
-    found by a search and placed at its near end, 0.75-0.87 m from its middle, in three seeds of
-    `bicycle_wheeled_beside_another` (network, 7 December 2026); with views no test saw cut first,
-    then (seed 0 again, and seed 2) with views the door frame cut."""
-    centre = np.asarray(percept.position, dtype=np.float64).copy()
-    if percept.viewpoint is None:
-        return centre
-    line = centre[:2] - np.asarray(percept.viewpoint, dtype=np.float64)[:2]
-    if not np.any(line):
-        return centre
-    axis = int(np.argmax(np.abs(line)))
-    shortfall = float(known_size[axis]) - float(percept.size[axis])
-    if shortfall > 0.0:
-        centre[axis] += math.copysign(shortfall / 2.0, float(line[axis]))
-    return centre
-
-
 def comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anchors: Sequence[Anchor]) -> np.ndarray:
     """(P, A) bool: whether views of the (P, 3) ``sizes`` may be compared by their look with each
     anchor's views.

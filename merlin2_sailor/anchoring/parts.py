@@ -28,6 +28,10 @@ Two parts of one object differ from two objects by evidence of space and time, n
   :data:`~.partial_view.PARTIAL_FOOTPRINT_SHARE` of it, as :mod:`.partial_view` tells a partial
   view), or its box was joined from parts before. Two anchors of whole views are the matching
   function's to tell apart, not this rule's;
+- **no end lies across them**: a box as wide as the class's short side and clearly shorter than
+  its long side shows the object's end, its long side running away from the camera
+  (:func:`~.object_centre.long_axis_shown`); two such ends side by side are two objects' ends, whatever
+  box they make together (:func:`an_end_lies_across`);
 - **they were never seen at one time**: two anchors seen in one frame are two percepts, two
   objects (every anchor keeps the symbols of anchors of its class seen in a frame with it,
   ``Anchor.seen_with``);
@@ -61,6 +65,7 @@ from merlin2_sailor.anchoring.colour_evidence import (
     part_shows_a_colour_the_whole_lacks,
 )
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
+from merlin2_sailor.anchoring.object_centre import long_axis_shown
 from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS, PARTIAL_FOOTPRINT_SHARE
 
 
@@ -148,6 +153,8 @@ def decide_parts(seen: Sequence[Anchor], index: AnchorIndex, slack: float,
             fits = bool(np.all(extent_of_both(anchor, other) <= fit))
             if not fits or not (is_part(anchor, known) or is_part(other, known)):
                 continue
+            if an_end_lies_across(anchor, other, known):
+                continue
             if colours_tell_apart(anchor, other, known, colour):
                 continue
             kept, part = (anchor, other) if anchor.first_seen <= other.first_seen else (other, anchor)
@@ -183,6 +190,19 @@ def extent_of_both(anchor: Anchor, other: Anchor) -> np.ndarray:
     if _share_width(anchor, other, across):
         width = max(float(anchor.size[across]), float(other.size[across]))
     return np.array([span[along], width, span[2]])
+
+
+def an_end_lies_across(anchor: Anchor, other: Anchor, known: np.ndarray) -> bool:
+    """Whether either anchor's box shows its object's end (:func:`~.object_centre.long_axis_shown`: as
+    wide as the class's short side, its long side running away from it) while the box around both
+    runs across that: two ends side by side are the ends of two objects, not two parts of one lying
+    the other way. Two bicycles 0.65 m apart, each seen only end-on and never at one time, made a box
+    1.0 x 0.26 m, which fits a bicycle lying across them, and were joined (scenario suite,
+    `bicycle_wheeled_beside_another`, network, seed 0, 7 December 2026)."""
+    low, high = box_around(anchor, other)
+    along, _ = _along_and_across(high - low)
+    return any(axis is not None and axis != along
+               for axis in (long_axis_shown(anchor.size, known), long_axis_shown(other.size, known)))
 
 
 def reaches_past(whole: Anchor, part: Anchor) -> bool:

@@ -14,7 +14,6 @@ from merlin2_sailor.anchoring.anchor_comparison import identity_scores
 from merlin2_sailor.anchoring.features import extent_slack
 from merlin2_sailor.anchoring.partial_view import (
     PartialViewConfig,
-    centre_beyond_near_face,
     comparable_views,
     partial_views,
     smaller_than_known,
@@ -329,21 +328,3 @@ def test_a_search_confirmed_by_a_view_of_the_near_face_puts_the_anchor_beyond_it
     assert bicycle.state is AnchorState.CONFIRMED and bicycle.expectation is None
     assert np.linalg.norm(bicycle.position[:2] - moved_to) < 0.25  # the face's own centre is 0.65 m off
     assert bicycle.size[1] == pytest.approx(1.6, abs=0.1)  # a face is no whole view: the extent stays
-
-
-def test_the_middle_of_a_near_face_is_beyond_it_only_by_what_the_view_lacks() -> None:
-    """:func:`centre_beyond_near_face`: along the axis nearest the line of sight, away from the
-    viewpoint, by half the known extent's excess over the view's; a view as long as the object, one
-    across it, or one without a viewpoint stays where it is."""
-    percept = dataclasses.replace(PerceptMaker(seed=1).percept(BICYCLE, 0.0), position=np.array((3.0, 2.35, 0.5)),
-                                  size=np.array((0.35, 0.3, 1.0)), viewpoint=np.array((3.0, 0.0, 1.0)))
-    known = np.array((0.35, 1.6, 1.0))
-    assert centre_beyond_near_face(percept, known)[:2] == pytest.approx((3.0, 3.0))
-    assert centre_beyond_near_face(percept, known)[2] == pytest.approx(0.5)
-    across = dataclasses.replace(percept, viewpoint=np.array((0.0, 2.35, 1.0)))  # the long side faces it
-    assert centre_beyond_near_face(across, known)[:2] == pytest.approx((3.0, 2.35))
-    assert centre_beyond_near_face(dataclasses.replace(percept, viewpoint=None), known)[:2] == pytest.approx(
-        (3.0, 2.35))
-    assert centre_beyond_near_face(percept, np.array((0.35, 0.3, 1.0)))[:2] == pytest.approx((3.0, 2.35))
-    from_the_north_east = dataclasses.replace(percept, viewpoint=np.array((3.6, 3.5, 1.0)))
-    assert centre_beyond_near_face(from_the_north_east, known)[:2] == pytest.approx((3.0, 1.7))
