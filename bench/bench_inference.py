@@ -84,7 +84,7 @@ def frame_pairs(count: int, dimension: int) -> PairFeatures:
     difference = np.abs(rng.normal(0.0, 0.5, (count, dimension))).astype(np.float32)
     return PairFeatures(
         rows=np.arange(count), columns=np.arange(count), same_class=np.ones(count, dtype=bool), distance=distance,
-        footprint_distance=distance, distance_score=np.exp(-distance), separation=widths_apart,
+        footprint_distance=distance, place_distance=distance, distance_score=np.exp(-distance), separation=widths_apart,
         separation_score=np.exp(-widths_apart), scale=rng.uniform(0.7, 1.4, count),
         time_difference=elapsed, time_score=np.exp(-elapsed / 30.0), searched=np.zeros(count, dtype=bool),
         appearance_known=np.ones(count, dtype=bool), appearance_distance=difference.sum(axis=1),

@@ -7,8 +7,10 @@ by position, which is what the rule encodes.
 
 score = same_class * exp(-0.5 * (d / sigma)^2),  sigma = min(position_sigma + drift_speed * |dt|, maximum_sigma)
 
-where d is the distance between the centres, less what a large object's extent explains (two
-views of a bicycle, end-on and side-on, are centred up to 0.65 m apart; see ``features``).
+where d is the distance between the centres, less what a large object's extent *along the line
+between them* explains (a part of a bicycle is centred up to 0.65 m from its middle, along it;
+never farther across it than it is wide: ``features.extent_slack_along``). The network reads the
+distance less the extent in any direction (``footprint_distance``), as it was trained.
 
 ``sigma`` grows with the time since the anchor was last seen, because an object unseen for a
 while may have been moved a little; with the defaults a fresh pair scores 0.5 at 0.35 m.
@@ -68,5 +70,5 @@ class RuleMatcher(Matcher):
             self.config.position_sigma + self.config.drift_speed * np.abs(features.time_difference),
             self.config.maximum_sigma,
         )
-        closeness = np.exp(-0.5 * (features.footprint_distance / sigma) ** 2)
+        closeness = np.exp(-0.5 * (features.place_distance / sigma) ** 2)
         return np.where(features.same_class, closeness, 0.0)

@@ -77,6 +77,7 @@ def random_pairs(count: int, dimension: int, seed: int = 0) -> PairFeatures:
     return PairFeatures(
         rows=np.arange(count), columns=np.zeros(count, dtype=np.intp),
         same_class=generator.random(count) > 0.2, distance=distance, footprint_distance=distance,
+        place_distance=distance,
         distance_score=np.exp(-distance), separation=widths_apart, separation_score=np.exp(-widths_apart),
         scale=generator.uniform(0.5, 2.0, count),
         time_difference=time_difference, time_score=np.exp(-time_difference / 30.0),
