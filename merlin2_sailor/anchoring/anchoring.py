@@ -61,7 +61,7 @@ from merlin2_sailor.anchoring.matching_table import (
 from merlin2_sailor.anchoring.merge import apply_decision, join_parts, withdraw_stale_ambiguities
 from merlin2_sailor.anchoring.object_centre import placed_on_objects
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
-from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views
+from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, spans_known_whole
 from merlin2_sailor.anchoring.parts import decide_parts, largest_seen_whole, note_seen_together
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
 from merlin2_sailor.anchoring.place_return import Return, decide_returns, note_jump
@@ -227,14 +227,20 @@ class Anchoring:
         forget_expired(self._index, changes, self.config.lifecycle)
         previously_visible = self._index.visible()
 
+        known = self._known_extents(percepts)
         told = partial is not None
-        partial = [bool(flag) for flag in partial] if told else partial_views(percepts, camera,
-                                                                              self.config.partial_view)
+        if told:
+            partial = [bool(flag) for flag in partial]
+        else:
+            # A view as large as the largest whole one of its class lacks nothing, cut or not.
+            partial = [cut and not spans_known_whole(percept.size, known[percept.class_name])
+                       for percept, cut in zip(percepts, partial_views(percepts, camera, self.config.partial_view),
+                                               strict=True)]
         # Unless something says which views are whole, no single view is colour evidence.
         whole = None if camera is None and not told else [not flag for flag in partial]
         # A large object's view is centred on the face the camera saw; its object's middle lies beyond
         # (:mod:`.object_centre`). After the partial-view tests, which measure the face itself.
-        percepts = placed_on_objects(percepts, self._known_extent)
+        percepts = placed_on_objects(percepts, known)
         # The pose error all of this frame's percepts share is taken out before anything is judged;
         # views of a row that sits off its anchors by an error read two ways are held out.
         reading = read_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
@@ -443,9 +449,10 @@ class Anchoring:
 
     # --- internals --------------------------------------------------------------------------
 
-    def _known_extent(self, class_name: str) -> np.ndarray | None:
-        """The extent of the largest whole one of the class seen (None: none, or a small class)."""
-        return largest_seen_whole(self._index, class_name, self.config.repair.part_slack)
+    def _known_extents(self, percepts: Sequence[Percept]) -> dict[str, np.ndarray | None]:
+        """{class of a percept: the extent of the largest whole one of it seen (None: none, or small)}."""
+        return {class_name: largest_seen_whole(self._index, class_name, self.config.repair.part_slack)
+                for class_name in {percept.class_name for percept in percepts}}
 
     def _fresh_symbol(self, class_name: str) -> str:
         symbol = self._new_symbol(class_name)

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -96,20 +96,14 @@ def object_centre(percept: Percept, known: np.ndarray) -> np.ndarray:
 
 
 def placed_on_objects(
-    percepts: Sequence[Percept], known_extent: Callable[[str], np.ndarray | None]
+    percepts: Sequence[Percept], known: Mapping[str, np.ndarray | None]
 ) -> tuple[Percept, ...]:
-    """The percepts, each centred on its object (:func:`object_centre`) where its class has a
-    ``known_extent`` (asked once per class; None: no large one seen whole)."""
-    known_of_class: dict[str, np.ndarray | None] = {}
+    """The percepts, each centred on its object (:func:`object_centre`) where ``known`` holds an
+    extent for its class (None or absent: no large one of it seen whole)."""
     placed = []
     for percept in percepts:
-        if percept.viewpoint is None:
-            placed.append(percept)
-            continue
-        if percept.class_name not in known_of_class:
-            known_of_class[percept.class_name] = known_extent(percept.class_name)
-        known = known_of_class[percept.class_name]
-        centre = None if known is None else object_centre(percept, known)
+        extent = known.get(percept.class_name)
+        centre = None if extent is None else object_centre(percept, extent)
         if centre is None or np.array_equal(centre, percept.position):
             placed.append(percept)
         else:

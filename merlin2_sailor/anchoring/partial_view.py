@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from merlin2_sailor.anchoring.anchor import Anchor
+from merlin2_sailor.anchoring.anchor import Anchor, turned_extent
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
 from merlin2_sailor.anchoring.visibility import CameraView
 from merlin2_sailor.contract.percept import Percept
@@ -88,6 +88,26 @@ EXTENT_CORROBORATING_VIEWS = 2
 def smaller_than_known(percept: Percept, anchor: Anchor) -> bool:
     """Whether a percept shows clearly less of a large object than the anchor's whole views did."""
     return bool(_shows_less(np.asarray(percept.size, dtype=np.float64).reshape(1, 3), [anchor])[0, 0])
+
+
+#: A view whose box spans at least this share of the largest whole one of its class, along its
+#: footprint and up, shows the whole object, whatever the cut tests say (see :func:`spans_known_whole`).
+WHOLE_EXTENT_SHARE = 0.9
+
+
+def spans_known_whole(size: np.ndarray, known: np.ndarray | None) -> bool:
+    """Whether a box of ``size`` spans the ``known`` extent of its class's largest whole one
+    (:func:`~.anchor.turned_extent`; None: none seen), its length and its height, within
+    ``WHOLE_EXTENT_SHARE``: a view that shows all of the object lacks nothing, though a nearer
+    surface stands beside it or the image's edge touches its box. The two bicycles of
+    `bicycle_wheeled_beside_another` stand 0.3 m apart; a whole view of one, 1.64 m of its 1.6, had
+    the other beside it, nearer the camera, and was taken as cut (scenario suite, network, 7 December
+    2026): its look and colour never counted, its anchor kept the box of its end, and a search could
+    never compare it with the bicycle it sought."""
+    if known is None:
+        return False
+    extent = turned_extent(np.asarray(size, dtype=np.float64))
+    return bool(extent[0] >= WHOLE_EXTENT_SHARE * float(known[0]) and extent[2] >= WHOLE_EXTENT_SHARE * float(known[2]))
 
 
 def comparable_views(sizes: np.ndarray, whole: Sequence[bool] | None, anchors: Sequence[Anchor]) -> np.ndarray:

@@ -356,3 +356,28 @@ def test_a_search_confirmed_by_a_view_of_the_near_face_puts_the_anchor_beyond_it
     assert bicycle.state is AnchorState.CONFIRMED and bicycle.expectation is None
     assert np.linalg.norm(bicycle.position[:2] - moved_to) < 0.25  # the face's own centre is 0.65 m off
     assert bicycle.size[1] == pytest.approx(1.6, abs=0.1)  # a face is no whole view: the extent stays
+
+
+@pytest.mark.parametrize(("size", "whole"), [((0.35, 1.6, 1.0), True), ((1.5, 0.36, 0.95), True),
+                                             ((0.35, 1.2, 1.0), False), ((0.35, 1.6, 0.6), False)],
+                         ids=["all of it", "all of it, turned", "a shorter piece", "its lower part"])
+def test_a_view_spanning_the_class_s_whole_extent_lacks_nothing(size, whole) -> None:
+    from merlin2_sailor.anchoring.partial_view import spans_known_whole
+    assert spans_known_whole(np.array(size), np.array((1.6, 0.35, 1.0))) is whole
+    assert spans_known_whole(np.array(size), None) is False  # no whole one seen: nothing to span
+
+
+def test_a_whole_bicycle_touching_the_images_edge_is_a_whole_view_once_one_was_seen(make_anchoring, maker) -> None:
+    """Cut by the camera's test (its box touches the edge), a view as long and high as the whole
+    bicycle seen before is whole all the same: it counts as a whole view of its anchor; a piece
+    with the same box stays partial."""
+    anchoring = make_anchoring()
+    camera = camera_view()
+    for frame in range(3):
+        anchoring.process([view_of(maker, BICYCLE, frame * 0.1, MIDDLE_BOX)], camera, frame * 0.1)
+    [bicycle] = anchoring.anchors
+    before = bicycle.whole_views
+    anchoring.process([view_of(maker, BICYCLE, 0.3, EDGE_BOX, size=(0.35, 0.9, 1.0))], camera, 0.3)
+    assert bicycle.whole_views == before  # a piece, cut: partial
+    anchoring.process([view_of(maker, BICYCLE, 0.4, EDGE_BOX, size=(0.36, 1.62, 0.98))], camera, 0.4)
+    assert bicycle.whole_views == before + 1
