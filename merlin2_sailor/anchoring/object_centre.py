@@ -58,13 +58,21 @@ def long_axis_shown(size: np.ndarray, known: np.ndarray) -> int | None:
     :func:`~.anchor.turned_extent`). Such a box shows the object's end (seen along its length), or a
     piece of it seen across its thickness; either way its long side runs along this axis. None where
     the box spans the short side on neither axis or on both, or the class is about as long as wide."""
-    long_side, short_side = float(known[0]), float(known[1])
-    if long_side < ELONGATION * short_side:
+    if not _elongated(known):
         return None
-    axes = [along for along in (0, 1)
-            if abs(float(size[1 - along]) - short_side) <= END_WIDTH_TOLERANCE * short_side
-            and float(size[along]) < (1.0 - END_WIDTH_TOLERANCE) * long_side]
+    axes = [along for along in (0, 1) if _shows_an_end(float(size[1 - along]), float(size[along]), known)]
     return axes[0] if len(axes) == 1 else None
+
+
+def _elongated(known: np.ndarray) -> bool:
+    return float(known[0]) >= ELONGATION * float(known[1])
+
+
+def _shows_an_end(across: float, along: float, known: np.ndarray) -> bool:
+    """A box ``across`` m wide about the class's short side and ``along`` m clearly less than its long side."""
+    long_side, short_side = float(known[0]), float(known[1])
+    return (abs(across - short_side) <= END_WIDTH_TOLERANCE * short_side
+            and along < (1.0 - END_WIDTH_TOLERANCE) * long_side)
 
 
 def object_centre(percept: Percept, known: np.ndarray) -> np.ndarray:
@@ -77,19 +85,17 @@ def object_centre(percept: Percept, known: np.ndarray) -> np.ndarray:
     line = centre[:2] - np.asarray(percept.viewpoint, dtype=np.float64)[:2]
     if not np.any(line):
         return centre
-    sight = int(np.argmax(np.abs(line)))
-    long_side, short_side = float(known[0]), float(known[1])
-    across = float(percept.size[1 - sight])
-    if long_side < ELONGATION * short_side:
+    if not _elongated(known):
         return centre
-    if abs(across - short_side) <= END_WIDTH_TOLERANCE * short_side \
-            and float(percept.size[sight]) < (1.0 - END_WIDTH_TOLERANCE) * long_side:
-        depth = long_side  # its end: as wide as the object, the rest beyond along the line of sight
-    elif across > (1.0 + END_WIDTH_TOLERANCE) * short_side:
-        depth = short_side
+    sight = int(np.argmax(np.abs(line)))
+    across, seen_depth = float(percept.size[1 - sight]), float(percept.size[sight])
+    if _shows_an_end(across, seen_depth, known):
+        depth = float(known[0])  # its end: as wide as the object, the rest beyond along the line of sight
+    elif across > (1.0 + END_WIDTH_TOLERANCE) * float(known[1]):
+        depth = float(known[1])  # its side
     else:
         return centre
-    shortfall = depth - float(percept.size[sight])
+    shortfall = depth - seen_depth
     if shortfall > 0.0:
         centre[sight] += math.copysign(shortfall / 2.0, float(line[sight]))
     return centre
