@@ -45,7 +45,7 @@ class TruthTimeline:
 
 
 def refers_to(anchor: AnchorRecord, last_seen: float, timeline: TruthTimeline,
-               max_distance: float = REFERS_DISTANCE) -> str | None:
+              max_distance: float = REFERS_DISTANCE) -> str | None:
     """The id of the object ``anchor`` refers to (nearest of its class at its last sighting), or None."""
     return nearest_of_class(anchor, timeline.at(last_seen), lambda obj: (math.dist(obj.position, anchor.position),),
                             max_distance)

@@ -106,13 +106,18 @@ def extent_slack_along(offsets: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     slack across its 0.35 m width, and scored 1.00 by place against the anchor of another bicycle
     standing 0.56 m beside it as against its own (scenario suite, `bicycle_wheeled_beside_another`,
     network, seed 0, 7 December 2026)."""
+    return np.maximum(width_along(offsets, sizes) - SMALL_OBJECT_EXTENT, 0.0) / 2.0
+
+
+def width_along(offsets: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """The width of each axis-aligned box of ``sizes`` (..., 3) along its horizontal ``offset``
+    (..., 3); for a vertical or zero offset, its longest horizontal side."""
     offsets = np.asarray(offsets, dtype=np.float64)[..., :2]
     sizes = np.asarray(sizes, dtype=np.float64)[..., :2]
     length = np.linalg.norm(offsets, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         direction = np.abs(np.where(length > 1e-9, offsets / length, 0.0))
-    along = np.where(length[..., 0] > 1e-9, (direction * sizes).sum(axis=-1), sizes.max(axis=-1))
-    return np.maximum(along - SMALL_OBJECT_EXTENT, 0.0) / 2.0
+    return np.where(length[..., 0] > 1e-9, (direction * sizes).sum(axis=-1), sizes.max(axis=-1))
 
 
 def encode_distance(distance: np.ndarray) -> np.ndarray:
@@ -131,17 +136,8 @@ def separation(offsets: np.ndarray, distances: np.ndarray, sizes_a: np.ndarray, 
     """``distances`` in widths of the wider of two axis-aligned boxes along each horizontal
     ``offset`` (centre to centre); a vertical or zero offset is measured in the boxes' longest
     horizontal side."""
-    offsets = np.asarray(offsets, dtype=np.float64)[..., :2]
-    length = np.linalg.norm(offsets, axis=-1, keepdims=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        direction = np.abs(np.where(length > 1e-9, offsets / length, 0.0))
-
-    def width(sizes: np.ndarray) -> np.ndarray:
-        sizes = np.asarray(sizes, dtype=np.float64)[..., :2]
-        along = (direction * sizes).sum(axis=-1)
-        return np.where(length[..., 0] > 1e-9, along, sizes.max(axis=-1))
-
-    widths = np.maximum(np.maximum(width(sizes_a), width(sizes_b)), MINIMUM_SEPARATION_WIDTH)
+    widths = np.maximum(np.maximum(width_along(offsets, sizes_a), width_along(offsets, sizes_b)),
+                        MINIMUM_SEPARATION_WIDTH)
     return np.asarray(distances, dtype=np.float64) / widths
 
 
