@@ -240,7 +240,7 @@ class Anchoring:
         whole = None if camera is None and not told else [not flag for flag in partial]
         # A large object's view is centred on the face the camera saw; its object's middle lies beyond
         # (:mod:`.object_centre`). After the partial-view tests, which measure the face itself.
-        percepts = placed_on_objects(percepts, known)
+        percepts = placed_on_objects(percepts, known, partial, self._anchor_centres(known))
         # The pose error all of this frame's percepts share is taken out before anything is judged;
         # views of a row that sits off its anchors by an error read two ways are held out.
         reading = read_frame(percepts, self._index, self.config.registration, whole, self.config.colour)
@@ -453,6 +453,11 @@ class Anchoring:
         """{class of a percept: the extent of the largest whole one of it seen (None: none, or small)}."""
         return {class_name: largest_seen_whole(self._index, class_name, self.config.repair.part_slack)
                 for class_name in {percept.class_name for percept in percepts}}
+
+    def _anchor_centres(self, known: Mapping[str, np.ndarray | None]) -> dict[str, list[np.ndarray]]:
+        """{class of a percept with a known extent: where its anchors stand}."""
+        return {class_name: [anchor.position for anchor in self._index.of_class(class_name)]
+                for class_name, extent in known.items() if extent is not None}
 
     def _fresh_symbol(self, class_name: str) -> str:
         symbol = self._new_symbol(class_name)

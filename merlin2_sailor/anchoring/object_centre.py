@@ -26,6 +26,19 @@ known extent (the largest one the robot has seen whole: :func:`.parts.largest_se
   or of one about as long as it is wide (which way it stands cannot be told), or without a
   viewpoint.
 
+A box about as wide as the short side that is also *cut* (by the image's edge, a door frame, an
+occluder) reads both ways: an end, or a piece of the side as wide as the object is thick. The two
+readings lie most of the long side apart, and the box's width alone flips between them from one
+frame to the next: in `large_object_wheeled_away` (network, seed 1, 7 December 2026) one piece of
+the wheeled bicycle's side, 0.45 m of it seen across its length (the class's short side 0.37 m),
+was read as a side in one frame and as an end in the next, placed 0.75 m beyond the bicycle and
+anchored anew, and the search then had two candidates. Measured over five runs of the large-object
+scenarios: boxes of true ends 0.27-0.39 m wide (short sides 0.34-0.37 m), side pieces read as ends
+0.43-0.45 m, every one cut. So a cut view of that width takes the reading that lands nearer an
+anchor of its class (the object it is a part of, where the robot knows it: the camera faces the
+side of it that lies nearer); with none within the long side of either reading, it reads as an
+end, as a whole view of that width always does (a whole side is as wide as the long side).
+
 Only the centre moves, never the size: what the view showed is still a part, and its look, colour
 and extent are judged as a part's (:mod:`.partial_view`). The same reading tells, for the parts
 rule, which way an end seen alone says its object stands (:mod:`.parts`).
@@ -75,10 +88,14 @@ def _shows_an_end(across: float, along: float, known: np.ndarray) -> bool:
             and along < (1.0 - END_WIDTH_TOLERANCE) * long_side)
 
 
-def object_centre(percept: Percept, known: np.ndarray) -> np.ndarray:
+def object_centre(
+    percept: Percept, known: np.ndarray, cut: bool = False, nearby: Sequence[np.ndarray] = ()
+) -> np.ndarray:
     """Where the object a view of its near face shows has its middle (world frame, m), given its
     class's ``known`` extent (:func:`~.anchor.turned_extent`): the view's centre, moved away from the
-    viewpoint along the sight axis by half the object's depth the view lacks (see the module)."""
+    viewpoint along the sight axis by half the object's depth the view lacks (see the module).
+    ``cut``: whether the view is cut (its width may be a piece's); ``nearby``: the centres of the
+    anchors of its class, which choose between the readings of a cut view that reads both ways."""
     centre = np.asarray(percept.position, dtype=np.float64).copy()
     if percept.viewpoint is None:
         return centre
@@ -89,27 +106,49 @@ def object_centre(percept: Percept, known: np.ndarray) -> np.ndarray:
         return centre
     sight = int(np.argmax(np.abs(line)))
     across, seen_depth = float(percept.size[1 - sight]), float(percept.size[sight])
+    long_side, short_side = float(known[0]), float(known[1])
+
+    def beyond(depth: float) -> np.ndarray:
+        placed = centre.copy()
+        shortfall = depth - seen_depth
+        if shortfall > 0.0:
+            placed[sight] += math.copysign(shortfall / 2.0, float(line[sight]))
+        return placed
+
     if _shows_an_end(across, seen_depth, known):
-        depth = float(known[0])  # its end: as wide as the object, the rest beyond along the line of sight
-    elif across > (1.0 + END_WIDTH_TOLERANCE) * float(known[1]):
-        depth = float(known[1])  # its side
-    else:
-        return centre
-    shortfall = depth - seen_depth
-    if shortfall > 0.0:
-        centre[sight] += math.copysign(shortfall / 2.0, float(line[sight]))
+        as_end = beyond(long_side)  # its end: as wide as the object, the rest beyond along the line of sight
+        return _nearer_anchor(as_end, beyond(short_side), nearby, long_side) if cut else as_end
+    if across > (1.0 + END_WIDTH_TOLERANCE) * short_side:
+        return beyond(short_side)  # its side
     return centre
 
 
+def _nearer_anchor(as_end: np.ndarray, as_side: np.ndarray, nearby: Sequence[np.ndarray], reach: float) -> np.ndarray:
+    """The reading of a cut view (its end, a piece of its side) nearer an anchor of its class, where
+    one stands within ``reach`` of either; else the end's."""
+    def distance(centre: np.ndarray) -> float:
+        return min((float(np.linalg.norm(centre[:2] - np.asarray(other, dtype=np.float64)[:2])) for other in nearby),
+                   default=math.inf)
+
+    to_end, to_side = distance(as_end), distance(as_side)
+    if min(to_end, to_side) > reach:
+        return as_end
+    return as_side if to_side < to_end else as_end
+
+
 def placed_on_objects(
-    percepts: Sequence[Percept], known: Mapping[str, np.ndarray | None]
+    percepts: Sequence[Percept], known: Mapping[str, np.ndarray | None], cut: Sequence[bool] | None = None,
+    anchors_at: Mapping[str, Sequence[np.ndarray]] | None = None,
 ) -> tuple[Percept, ...]:
     """The percepts, each centred on its object (:func:`object_centre`) where ``known`` holds an
-    extent for its class (None or absent: no large one of it seen whole)."""
+    extent for its class (None or absent: no large one of it seen whole). ``cut``: per percept,
+    whether it is cut (None: none is); ``anchors_at``: per class, its anchors' centres."""
     placed = []
-    for percept in percepts:
+    for row, percept in enumerate(percepts):
         extent = known.get(percept.class_name)
-        centre = None if extent is None else object_centre(percept, extent)
+        nearby = () if anchors_at is None else anchors_at.get(percept.class_name, ())
+        centre = None if extent is None else object_centre(
+            percept, extent, cut=bool(cut[row]) if cut is not None else False, nearby=nearby)
         if centre is None or np.array_equal(centre, percept.position):
             placed.append(percept)
         else:

@@ -88,6 +88,58 @@ def test_only_views_of_a_class_with_a_known_extent_are_moved() -> None:
     assert placed[1] is mug and placed[2] is tv
 
 
+
+# --- a cut view as wide as the object is thick: an end, or a piece of its side ---------------------
+
+SIDE_PIECE = (0.15, 0.42, 1.0)  # 0.42 m of a side along y, 0.15 m deep: 1.2 times the short side
+
+
+@pytest.mark.parametrize("turn", [False, True], ids=["standing along y", "standing along x"])
+@pytest.mark.parametrize("from_the_far_side", [False, True], ids=["from the east", "from the west"])
+def test_a_cut_piece_of_a_known_objects_side_stays_on_it(turn, from_the_far_side) -> None:
+    """A bicycle standing along y at (3.6, 5.2) is anchored at its middle; a cut view of 0.42 m of
+    its east (or west) face, near its north end, reads by width alone as an end and would be placed
+    0.7 m beyond the bicycle. The anchor says which side the camera faces: the piece stays on it."""
+    middle, face_x = np.array((3.6, 5.2, 0.5)), 3.6 + 0.175 + 0.075
+    viewpoint = np.array((6.0, 5.4, 1.0))
+    if from_the_far_side:
+        face_x, viewpoint = 3.6 - 0.175 - 0.075, np.array((1.2, 5.4, 1.0))
+    centre, size = np.array((face_x, 5.7, 0.5)), np.array(SIDE_PIECE)
+    if turn:
+        middle, centre, size, viewpoint = middle[[1, 0, 2]], centre[[1, 0, 2]], size[[1, 0, 2]], viewpoint[[1, 0, 2]]
+    piece = view(centre, size, viewpoint)
+    assert long_axis_shown(size, KNOWN) is not None  # the width alone says "an end"
+    placed = object_centre(piece, KNOWN, cut=True, nearby=[middle])
+    sight = 1 if turn else 0
+    assert abs(placed[sight] - middle[sight]) < 0.2  # on the bicycle, the side's reading
+    alone = object_centre(piece, KNOWN, cut=True)
+    assert abs(alone[sight] - middle[sight]) > 0.4  # no anchor to ask: the end's reading, 0.7 m beyond the face
+
+
+def test_a_cut_end_beside_a_known_object_of_its_class_still_reads_as_an_end() -> None:
+    """The east bicycle's south end, cut, seen from the south, with the west bicycle (0.65 m
+    beside) anchored at its middle: the end's reading lands 0.65 m from that anchor, the side's
+    farther, so the east one is placed at its own middle."""
+    end = view((EAST[0], 5.85, 0.5), (0.36, 0.1, 1.0), (3.25, 4.0, 1.0))
+    placed = object_centre(end, KNOWN, cut=True, nearby=[np.array((*WEST, 0.5))])
+    assert placed[:2] == pytest.approx(EAST, abs=0.1)
+
+
+def test_a_whole_view_as_wide_as_the_object_is_thick_is_its_end_whatever_stands_near() -> None:
+    """Uncut, a box of that width cannot be a piece of the side (a whole side is as wide as the long
+    side): it reads as an end even beside an anchor that the other reading would land on."""
+    piece = view((3.85, 5.7, 0.5), SIDE_PIECE, (6.0, 5.4, 1.0))
+    placed = object_centre(piece, KNOWN, cut=False, nearby=[np.array((3.6, 5.2, 0.5))])
+    assert placed[0] == pytest.approx(3.85 - (1.6 - 0.15) / 2.0)
+
+
+def test_placing_asks_each_views_own_cut_and_class_anchors() -> None:
+    piece = view((3.85, 5.7, 0.5), SIDE_PIECE, (6.0, 5.4, 1.0))
+    placed = placed_on_objects([piece, piece], {"bicycle": KNOWN}, cut=[True, False],
+                               anchors_at={"bicycle": [np.array((3.6, 5.2, 0.5))], "tv": []})
+    assert placed[0].position[0] == pytest.approx(3.85 - 0.1)  # half the short side less the depth seen
+    assert placed[1].position[0] == pytest.approx(3.85 - 0.725)
+
 # --- the parts rule: two ends side by side --------------------------------------------------------
 
 @pytest.mark.parametrize("turn", [False, True], ids=["standing along y", "standing along x"])
@@ -161,3 +213,21 @@ def test_two_bicycles_seen_end_on_keep_their_own_views_and_symbols() -> None:
     assert np.linalg.norm(west.position[:2] - WEST) < 0.1  # and the west one's place is its own
     assert not [event for event in events if event.kind is AnchorEventKind.FORGOTTEN
                 and event.symbol in (west.symbol, east.symbol)]
+
+
+
+def test_a_known_bicycles_cut_side_pieces_stay_its_own_views() -> None:
+    """Frame by frame through the core: the hall's bicycle known whole (standing along y at
+    (6.0, 1.0)), then cut views of pieces of its east face, each as wide as the bicycle is thick,
+    seen from the east and from the west: one anchor, no new one beside the bicycle (the rules
+    forgive a view placed off its object along its length, not across it)."""
+    anchoring, maker, stamp = anchoring_that_knows_a_bicycle()
+    [known] = anchoring.anchors
+    events = []
+    for face_x, viewpoint in ((6.25, (8.0, 1.2, 1.0)), (5.75, (4.0, 1.2, 1.0))):  # its east face, its west face
+        for piece_y in (1.0, 0.6):  # read as an end, placed 0.48 m off the bicycle across its short side
+            stamp, more = seen(anchoring, maker, stamp, (face_x, piece_y, 0.5), SIDE_PIECE, viewpoint)
+            events += more
+            stamp += 1.0
+    assert [anchor.symbol for anchor in anchoring.anchors] == [known.symbol]
+    assert not [event for event in events if event.kind is AnchorEventKind.ACQUIRED]
