@@ -62,7 +62,7 @@ from merlin2_sailor.anchoring.merge import apply_decision, join_parts, withdraw_
 from merlin2_sailor.anchoring.object_centre import placed_on_objects
 from merlin2_sailor.anchoring.observation import acquire, drop_expectation, reacquire
 from merlin2_sailor.anchoring.partial_view import PartialViewConfig, partial_views, spans_known_whole
-from merlin2_sailor.anchoring.parts import decide_parts, largest_seen_whole, note_seen_together
+from merlin2_sailor.anchoring.parts import decide_parts, largest_seen_whole, note_seen_together, seen_whole_at_last
 from merlin2_sailor.anchoring.percept_checks import check_percepts, point
 from merlin2_sailor.anchoring.place_return import Return, decide_returns, note_jump
 from merlin2_sailor.anchoring.rule_matcher import RuleMatcher
@@ -278,6 +278,7 @@ class Anchoring:
             why = matched_over(table, row, column) if anchor.state is AnchorState.MISSING else ""
             reacquire(anchor, percept, changes, config.fusion, config.lifecycle, config.expectation_tolerance,
                       continued=bool(table.continuations[row, column]), partial=partial[row], scored=why)
+            seen_whole_at_last(anchor, percept.size, not partial[row], known.get(percept.class_name))
             note_jump(anchor, before, stamp, config.repair.place_jump, config.repair.place_review)
             self._index.refresh(anchor)
             symbols[row] = anchor.symbol

@@ -66,7 +66,7 @@ from merlin2_sailor.anchoring.colour_evidence import (
 )
 from merlin2_sailor.anchoring.features import SMALL_OBJECT_EXTENT
 from merlin2_sailor.anchoring.object_centre import long_axis_shown
-from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS, PARTIAL_FOOTPRINT_SHARE
+from merlin2_sailor.anchoring.partial_view import EXTENT_CORROBORATING_VIEWS, PARTIAL_FOOTPRINT_SHARE, spans_known_whole
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -104,6 +104,27 @@ def note_seen_together(anchors: Iterable[Anchor], index: AnchorIndex) -> None:
         for anchor in together:
             anchor.seen_with = {symbol for symbol in anchor.seen_with | symbols
                                 if symbol != anchor.symbol and symbol in index}
+
+
+def seen_whole_at_last(anchor: Anchor, size: np.ndarray, whole: bool, known: np.ndarray | None) -> bool:
+    """Make an anchor joined from parts an anchor of a whole object, where it just took a whole view
+    (``whole``) whose box of ``size`` spans the class's ``known`` whole extent
+    (:func:`.partial_view.spans_known_whole`); return whether it did.
+
+    Its box, look and colour stop being its parts' from then on: a joined anchor's look is never
+    compared (its views were of parts, :mod:`.anchor_comparison`) and its colour is no evidence
+    (:mod:`.colour_evidence`), and without this it stays so for good, whatever it is seen as later.
+    Measured: the living room's bicycle, seen end-on in two parts and joined, was then seen whole
+    from its side six times (boxes 1.62-1.70 m long, uncut), its look and colour taken; a search for
+    the wheeled bicycle, of another look, still scored it 1.00 by class, place and time alone,
+    above the wheeled bicycle's own anchor (0.73, its look compared), and said it could not tell
+    the two apart (`bicycle_wheeled_beside_another`, network, seed 0, 8 December 2026)."""
+    if anchor.parts_fit is None or not whole or anchor.state is not AnchorState.CONFIRMED:
+        return False
+    if not spans_known_whole(size, known):
+        return False
+    anchor.parts_fit = None
+    return True
 
 
 def largest_seen_whole(index: AnchorIndex, class_name: str, slack: float) -> np.ndarray | None:

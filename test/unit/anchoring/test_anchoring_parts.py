@@ -18,7 +18,7 @@ import pytest
 
 from merlin2_sailor.anchoring import AnchorEventKind, Anchoring, AnchoringConfig, AnchorState, colour_evidence
 from merlin2_sailor.anchoring.anchor import Anchor
-from merlin2_sailor.anchoring.anchor_comparison import score_anywhere
+from merlin2_sailor.anchoring.anchor_comparison import looks_compared, score_anywhere
 from merlin2_sailor.anchoring.anchor_index import AnchorIndex
 from merlin2_sailor.anchoring.colour_evidence import ColourEvidenceConfig, ColourModel, with_view
 from merlin2_sailor.anchoring.expectation import Expectation
@@ -27,7 +27,7 @@ from merlin2_sailor.anchoring.gallery import add_view
 from merlin2_sailor.anchoring.identity_repair import RepairConfig
 from merlin2_sailor.anchoring.lifecycle import LifecycleConfig
 from merlin2_sailor.anchoring.merge import join_parts
-from merlin2_sailor.anchoring.parts import Parts, decide_parts, largest_seen_whole
+from merlin2_sailor.anchoring.parts import Parts, decide_parts, largest_seen_whole, seen_whole_at_last
 from merlin2_sailor.anchoring.snapshot import anchor_from_dict, anchor_to_dict, anchors_of_snapshot
 from merlin2_sailor.errors import ConfigurationError
 from merlin2_sailor.perception.colour_histogram import COLOUR_BINS, HUE_BINS
@@ -415,3 +415,35 @@ def test_a_box_joined_from_parts_is_compared_with_a_lost_anchor_without_its_look
     candidate.parts_fit = BICYCLE[[1, 0, 2]] * (1.0 + SLACK)
     without_look = score_anywhere(matcher, candidate, lost)
     assert by_look < 0.5 <= without_look
+
+
+@pytest.mark.parametrize(("length", "whole_at_last"), [(1.62, True), (1.0, False)],
+                         ids=["seen whole from its side", "a larger piece of it"])
+def test_a_box_joined_from_parts_seen_whole_at_last_is_compared_by_its_look(length, whole_at_last):
+    """The moved bicycle seen in three parts, joined; then seen whole (uncut, 1.62 m of its 1.6):
+    from then on it is the anchor of a whole bicycle, whose look a search compares. A larger piece
+    (1.0 m) is still a part, and the anchor stays one of parts."""
+    seen_whole = SceneObject("bicycle", "bicycle", (3.0, 4.0, 0.5), size=(0.35, length, 1.0))
+    frames = [[WHOLE]] * 10 + [[part("front wheel", 3.4)]] * 10 + [[part("middle", 4.0)]] * 10 \
+        + [[part("rear wheel", 4.58)]] * 10
+    anchoring, _ = run(frames)
+    moved = anchoring.get("bicycle_2")
+    assert moved.parts_fit is not None
+    more, _ = run(frames + [[seen_whole]] * 6)
+    moved, before = more.get("bicycle_2"), more.get("bicycle_1")
+    assert moved.state is AnchorState.CONFIRMED
+    assert (moved.parts_fit is None) is whole_at_last
+    assert bool(looks_compared(AppearanceRules(), [moved], before)[0]) is whole_at_last
+
+
+@pytest.mark.parametrize(("whole", "state", "known", "cleared"), [
+    (True, AnchorState.CONFIRMED, BICYCLE[[1, 0, 2]], True),
+    (False, AnchorState.CONFIRMED, BICYCLE[[1, 0, 2]], False),  # cut: the camera did not see all of it
+    (True, AnchorState.MISSING, BICYCLE[[1, 0, 2]], False),  # a sighting too few to bring it back
+    (True, AnchorState.CONFIRMED, None, False),  # no whole one of the class known to span
+], ids=["whole", "cut", "still missing", "no extent known"])
+def test_only_a_whole_view_spanning_the_known_extent_ends_a_box_of_parts(whole, state, known, cleared):
+    joined = bicycle("bicycle_2", 4.0, np.array((0.3, 1.4, 1.0)), state=state, whole_views=2)
+    joined.parts_fit = BICYCLE[[1, 0, 2]] * (1.0 + SLACK)
+    assert seen_whole_at_last(joined, np.array((0.1, 1.62, 1.0)), whole, known) is cleared
+    assert (joined.parts_fit is None) is cleared
