@@ -428,8 +428,8 @@ class MissionDemoNode(Node):
         with self._lock:
             self._anchors = records
             self._anchor_views = views
-            for record, seen, _ in views:
-                self._merges.note_view(record, seen)
+            for record, seen, size in views:
+                self._merges.note_view(record, seen, size)
 
     def _record_identities(self) -> None:
         try:

@@ -12,7 +12,11 @@ objects: one object's symbol went to the other. The *first* object, not the late
 took another object's views before the merge refers to that one by then (the living room's
 bicycle's anchor did), and the first is also what the planner was first told the symbol means.
 The footprint, not the centre: a bicycle seen only end-on is anchored at its near end, 0.8 m from
-its centre. An anchor never near an object of its class is recorded, not judged.
+its centre. An anchor never near an object of its class is recorded, not judged; nor is a view
+whose box takes in the centres of two objects of its class or more (a detector's box across two
+books of a shelf, anchored, then forgotten into one of the two as "not an object of its own", was
+judged the first book's and its merge wrong: `moved_to_the_far_room`, network, seed 0, 8 December
+2026), which is no one object's view.
 """
 
 from __future__ import annotations
@@ -24,6 +28,8 @@ from typing import Any
 
 from merlin2_sailor_demos.report.scorecard import AnchorRecord, TrueObject
 from merlin2_sailor_demos.report.truth_timeline import REFERS_DISTANCE, TruthTimeline, nearest_of_class
+
+Size = tuple[float, float, float]
 
 #: Sightings of each anchor kept to find the first object it was the anchor of: a few seconds' worth.
 FIRST_VIEWS = 64
@@ -61,14 +67,15 @@ class MergeLog:
 
     def __init__(self, first_views: int = FIRST_VIEWS) -> None:
         self._first_views = first_views
-        self._views: dict[str, list[tuple[AnchorRecord, float]]] = {}
+        self._views: dict[str, list[tuple[AnchorRecord, float, Size | None]]] = {}
         self._forgotten: list[tuple[float, str, str, str]] = []
 
-    def note_view(self, record: AnchorRecord, seen: float) -> None:
-        """An anchor as an anchors message showed it, last seen at ``seen``."""
+    def note_view(self, record: AnchorRecord, seen: float, size: Size | None = None) -> None:
+        """An anchor as an anchors message showed it, last seen at ``seen``, its box of ``size`` (m; None:
+        not told)."""
         views = self._views.setdefault(record.symbol, [])
         if len(views) < self._first_views and (not views or views[-1][1] != seen):
-            views.append((record, seen))
+            views.append((record, seen, size))
 
     def note_forgotten(self, symbol: str, into: str, stamp: float, reason: str) -> None:
         """``symbol`` was forgotten as ``into``'s object at ``stamp``."""
@@ -81,8 +88,20 @@ class MergeLog:
                 for stamp, symbol, into, reason in self._forgotten]
 
     def _first_object(self, symbol: str, timeline: TruthTimeline) -> str | None:
-        seen = (object_seen(record, timeline.at(stamp)) for record, stamp in self._views.get(symbol, ()))
+        seen = (object_seen(record, truth) for record, stamp, size in self._views.get(symbol, ())
+                if not across_several((truth := timeline.at(stamp)), record, size))
         return next((found for found in seen if found is not None), None)
+
+
+def across_several(truth: Sequence[TrueObject], anchor: AnchorRecord, size: Size | None) -> bool:
+    """Whether ``anchor``'s box (of ``size``; None: unknown, never) takes in, on the floor, the
+    centres of two objects of its class or more."""
+    if size is None:
+        return False
+    inside = [obj for obj in truth if obj.class_name == anchor.class_name
+              and abs(obj.position[0] - anchor.position[0]) <= size[0] / 2.0
+              and abs(obj.position[1] - anchor.position[1]) <= size[1] / 2.0]
+    return len(inside) >= 2
 
 
 def object_seen(anchor: AnchorRecord, truth: Sequence[TrueObject], max_distance: float = REFERS_DISTANCE) -> str | None:

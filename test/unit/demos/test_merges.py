@@ -109,3 +109,25 @@ def test_a_scorecard_without_merges_is_judged_as_before_and_a_malformed_one_is_r
     assert judge(scorecard()).right
     with pytest.raises(ValueError, match="no usable 'claims' section"):
         judge(scorecard(merges=[{"forgotten": "cup_2"}]))
+
+
+def test_a_box_across_two_objects_of_its_class_is_no_one_objects_anchor():
+    """A shelf's books 0.3 m apart; a detector's box 0.68 m wide across two of them, anchored, is
+    forgotten into one's anchor as not an object of its own: no object's symbol went to another's.
+    The same anchor with a book's box is that book's, and its merge into its neighbour's is wrong."""
+    shelf = tuple(TrueObject(f"book_{n}", "book", (1.7 + 0.3 * n, 7.8, 1.13), (0.2, 0.05, 0.26)) for n in range(4))
+    line = TruthTimeline()
+    line.record(0.0, shelf)
+
+    def judged(size: tuple[float, float, float]) -> MergeRecord:
+        log = MergeLog()
+        log.note_view(anchor("book_8", (2.30, 7.77, 1.13), "book"), 10.0, (0.22, 0.11, 0.26))
+        log.note_view(anchor("book_11", (2.13, 7.76, 1.21), "book"), 11.0, size)
+        log.note_forgotten("book_11", "book_8", 12.0, "a box across book_8 and book_7")
+        [merge] = log.judged(line)
+        return merge
+
+    across = judged((0.68, 0.49, 0.74))
+    assert (across.forgotten_refers, across.into_refers, across.wrong) == (None, "book_2", False)
+    one_book = judged((0.22, 0.11, 0.26))
+    assert (one_book.forgotten_refers, one_book.wrong) == ("book_1", True)
