@@ -32,7 +32,7 @@ readings lie most of the long side apart, and the box's width alone flips betwee
 frame to the next: in `large_object_wheeled_away` (network, seed 1, 7 December 2026) one piece of
 the wheeled bicycle's side, 0.45 m of it seen across its length (the class's short side 0.37 m),
 was read as a side in one frame and as an end in the next, placed 0.75 m beyond the bicycle and
-anchored anew, and the search then had two candidates. Measured over five runs of the large-object
+anchored anew, and the search then had two candidates. Measured over three runs of the large-object
 scenarios: boxes of true ends 0.27-0.39 m wide (short sides 0.34-0.37 m), side pieces read as ends
 0.43-0.45 m, every one cut. So a cut view of that width takes the reading that lands nearer an
 anchor of its class (the object it is a part of, where the robot knows it: the camera faces the
